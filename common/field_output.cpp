@@ -1,0 +1,174 @@
+#include "common/field_output.hpp"
+
+#include <unistd.h>
+
+#include <fstream>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+#include "common/hdf5_file.hpp"
+
+namespace outburst::output {
+
+namespace {
+
+std::string xml_escape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+void stamp_provenance(hdf5::H5Writer& w, const RunInfo& info) {
+  w.attribute("/", "program", info.program);
+  w.attribute("/", "version", info.version);
+  w.attribute("/", "scene_file", info.scene_file);
+  w.attribute("/", "scene_text", info.scene_text);
+  std::string overrides;
+  for (const auto& o : info.overrides) overrides += o + "\n";
+  w.attribute("/", "scene_overrides", overrides);
+  w.attribute("/", "units", info.units);
+}
+
+std::string data_item(const std::string& file, const std::string& path, std::size_t rows,
+                      int columns, bool integer) {
+  const std::string dims =
+      columns == 1 ? fmt::format("{}", rows) : fmt::format("{} {}", rows, columns);
+  return fmt::format(
+      R"(<DataItem Dimensions="{}" NumberType="{}" Precision="8" Format="HDF">{}:{}</DataItem>)",
+      dims, integer ? "Int" : "Float", file, path);
+}
+
+}  // namespace
+
+void write_file_atomically(const std::filesystem::path& path, const std::string& text) {
+  std::filesystem::path temp = path;
+  temp += fmt::format(".partial-{}", ::getpid());
+  {
+    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
+    out << text;
+    out.flush();
+    if (!out) throw std::runtime_error(fmt::format("cannot write {}", temp.string()));
+  }
+  std::filesystem::rename(temp, path);
+}
+
+void Snapshot::add(const std::string& grid, Field field) {
+  fields_[grid].push_back(std::move(field));
+}
+
+void Snapshot::set_points(const std::string& grid, std::vector<double> xyz) {
+  points_[grid] = std::move(xyz);
+}
+
+FieldSeries::FieldSeries(std::filesystem::path directory, std::string name, RunInfo info)
+    : directory_(std::move(directory)), name_(std::move(name)), info_(std::move(info)) {
+  std::filesystem::create_directories(directory_);
+}
+
+void FieldSeries::add_quad_mesh(const std::string& grid, const std::vector<double>& xyz,
+                                const std::vector<std::int64_t>& quads) {
+  hdf5::H5Writer w(directory_ / (name_ + "_" + grid + ".h5"));
+  w.write("/nodes", xyz.data(), {xyz.size() / 3, 3}, "m");
+  w.write("/cells", quads.data(), {quads.size() / 4, 4});
+  stamp_provenance(w, info_);
+  w.commit();
+  meshes_[grid] = {xyz.size() / 3, quads.size() / 4};
+}
+
+void FieldSeries::add_point_grid(const std::string& grid) { point_grids_.push_back(grid); }
+
+void FieldSeries::write(const Snapshot& snapshot) {
+  const std::string file = fmt::format("{}_{:06d}.h5", name_, written_.size());
+  hdf5::H5Writer w(directory_ / file);
+  stamp_provenance(w, info_);
+  w.attribute("/", "time", snapshot.time());
+  Written record{snapshot.time(), file, {}};
+  for (const auto& [grid, xyz] : snapshot.points_) {
+    const std::size_t n = xyz.size() / 3;
+    std::vector<std::int64_t> connectivity(n);
+    for (std::size_t i = 0; i < n; ++i) connectivity[i] = static_cast<std::int64_t>(i);
+    w.write("/" + grid + "/points", xyz.data(), {n, 3}, "m");
+    // Xdmf3 readers show nothing for a Polyvertex without explicit connectivity.
+    w.write("/" + grid + "/connectivity", connectivity.data(), {n});
+    record.grids[grid].points = n;
+  }
+  for (const auto& [grid, fields] : snapshot.fields_) {
+    for (const auto& f : fields) {
+      const std::size_t rows = f.values.size() / static_cast<std::size_t>(f.components);
+      if (f.components == 1)
+        w.write("/" + grid + "/" + f.name, f.values.data(), {rows}, f.unit);
+      else
+        w.write("/" + grid + "/" + f.name, f.values.data(),
+                {rows, static_cast<std::size_t>(f.components)}, f.unit);
+      record.grids[grid].fields.push_back({f.name, f.center, f.components});
+    }
+  }
+  w.commit();
+  written_.push_back(std::move(record));
+  write_index();
+}
+
+void FieldSeries::write_index() const {
+  std::string x;
+  x += "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"3.0\">\n<Domain>\n";
+  x += fmt::format("<Information Name=\"program\" Value=\"{} {}\"/>\n", xml_escape(info_.program),
+                   xml_escape(info_.version));
+  x += fmt::format("<Information Name=\"scene\" Value=\"{}\"/>\n", xml_escape(info_.scene_file));
+  x += fmt::format("<Information Name=\"units\" Value=\"{}\"/>\n", xml_escape(info_.units));
+  x += fmt::format("<Grid Name=\"{}\" GridType=\"Collection\" CollectionType=\"Temporal\">\n",
+                   xml_escape(name_));
+  for (const auto& snap : written_) {
+    const bool several = snap.grids.size() > 1;
+    if (several)
+      x += fmt::format(
+          "<Grid Name=\"t{:g}\" GridType=\"Collection\" CollectionType=\"Spatial\">\n"
+          "<Time Value=\"{:.17g}\"/>\n",
+          snap.time, snap.time);
+    for (const auto& [grid, data] : snap.grids) {
+      x += fmt::format("<Grid Name=\"{}\" GridType=\"Uniform\">\n", xml_escape(grid));
+      if (!several) x += fmt::format("<Time Value=\"{:.17g}\"/>\n", snap.time);
+      std::size_t nodes = 0, cells = 0;
+      if (const auto mesh = meshes_.find(grid); mesh != meshes_.end()) {
+        const std::string mesh_file = name_ + "_" + grid + ".h5";
+        nodes = mesh->second.nodes;
+        cells = mesh->second.cells;
+        x += fmt::format("<Topology TopologyType=\"Quadrilateral\" NumberOfElements=\"{}\">\n{}\n"
+                         "</Topology>\n",
+                         cells, data_item(mesh_file, "/cells", cells, 4, true));
+        x += fmt::format("<Geometry GeometryType=\"XYZ\">\n{}\n</Geometry>\n",
+                         data_item(mesh_file, "/nodes", nodes, 3, false));
+      } else {
+        nodes = cells = data.points;
+        x += fmt::format(
+            "<Topology TopologyType=\"Polyvertex\" NumberOfElements=\"{}\" "
+            "NodesPerElement=\"1\">\n{}\n</Topology>\n",
+            cells, data_item(snap.file, "/" + grid + "/connectivity", cells, 1, true));
+        x += fmt::format("<Geometry GeometryType=\"XYZ\">\n{}\n</Geometry>\n",
+                         data_item(snap.file, "/" + grid + "/points", nodes, 3, false));
+      }
+      for (const auto& f : data.fields) {
+        const std::size_t rows = f.center == Center::node ? nodes : cells;
+        x += fmt::format(
+            "<Attribute Name=\"{}\" AttributeType=\"{}\" Center=\"{}\">\n{}\n</Attribute>\n",
+            xml_escape(f.name), f.components == 1 ? "Scalar" : "Vector",
+            f.center == Center::node ? "Node" : "Cell",
+            data_item(snap.file, "/" + grid + "/" + f.name, rows, f.components, false));
+      }
+      x += "</Grid>\n";
+    }
+    if (several) x += "</Grid>\n";
+  }
+  x += "</Grid>\n</Domain>\n</Xdmf>\n";
+  write_file_atomically(index_path(), x);
+}
+
+}  // namespace outburst::output

@@ -1,0 +1,105 @@
+#pragma once
+// Time series of fields for ParaView: HDF5 data indexed by an XDMF file.
+//
+// Layout of an output folder:
+//   <name>_mesh.h5         static mesh geometry and topology, written once
+//   <name>_000042.h5       one file per snapshot (fields, moving point clouds)
+//   <name>.xdmf            the index ParaView opens; rewritten after each snapshot
+// Every file is written under a temporary name and renamed into place, so a run
+// that dies leaves complete snapshots and an index that lists only those. Each
+// HDF5 file carries the run's provenance (program, version, scene text, units).
+
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace outburst::output {
+
+struct RunInfo {
+  std::string program;
+  std::string version;
+  std::string scene_file;
+  std::string scene_text;
+  std::vector<std::string> overrides;
+  // Units of everything written, e.g. "SI: m, s, kg, Pa; P = p^2 in Pa^2".
+  std::string units;
+};
+
+enum class Center { node, cell };
+
+struct Field {
+  std::string name;
+  Center center;
+  int components;  // 1 scalar, 3 vector (2D vectors are padded with z = 0)
+  std::string unit;
+  std::vector<double> values;  // entity-major: values[i * components + c]
+};
+
+// What one output time holds: fields per grid, and the positions of point grids.
+class Snapshot {
+ public:
+  explicit Snapshot(double time) : time_(time) {}
+  void add(const std::string& grid, Field field);
+  // Point clouds (particles) move: their positions are part of every snapshot.
+  void set_points(const std::string& grid, std::vector<double> xyz);
+
+  double time() const { return time_; }
+
+ private:
+  friend class FieldSeries;
+  double time_;
+  std::map<std::string, std::vector<Field>> fields_;
+  std::map<std::string, std::vector<double>> points_;
+};
+
+class FieldSeries {
+ public:
+  FieldSeries(std::filesystem::path directory, std::string name, RunInfo info);
+
+  // A fixed quadrilateral mesh: xyz holds 3 coordinates per node, quads 4 node
+  // indices per cell (counter-clockwise).
+  void add_quad_mesh(const std::string& grid, const std::vector<double>& xyz,
+                     const std::vector<std::int64_t>& quads);
+  // A point cloud whose positions come with each snapshot.
+  void add_point_grid(const std::string& grid);
+
+  void write(const Snapshot& snapshot);
+
+  std::filesystem::path index_path() const { return directory_ / (name_ + ".xdmf"); }
+  std::size_t snapshots_written() const { return written_.size(); }
+
+ private:
+  struct MeshGrid {
+    std::size_t nodes = 0, cells = 0;
+  };
+  struct WrittenField {
+    std::string name;
+    Center center;
+    int components;
+  };
+  struct WrittenGrid {
+    std::size_t points = 0;  // point grids only
+    std::vector<WrittenField> fields;
+  };
+  struct Written {
+    double time;
+    std::string file;
+    std::map<std::string, WrittenGrid> grids;
+  };
+
+  void write_index() const;
+
+  std::filesystem::path directory_;
+  std::string name_;
+  RunInfo info_;
+  std::map<std::string, MeshGrid> meshes_;
+  std::vector<std::string> point_grids_;
+  std::vector<Written> written_;
+};
+
+// Replace `path` atomically with `text` (temporary file and rename).
+void write_file_atomically(const std::filesystem::path& path, const std::string& text);
+
+}  // namespace outburst::output

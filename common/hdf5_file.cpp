@@ -1,0 +1,185 @@
+#include "common/hdf5_file.hpp"
+
+#include <hdf5.h>
+#include <unistd.h>
+
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+namespace outburst::hdf5 {
+
+namespace {
+
+// HDF5 prints its own error stack to stderr by default; we report errors ourselves.
+void silence_hdf5() {
+  static const bool once = [] {
+    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+    return true;
+  }();
+  (void)once;
+}
+
+[[noreturn]] void fail(const std::filesystem::path& file, const std::string& what) {
+  throw std::runtime_error(fmt::format("HDF5 file {}: {}", file.string(), what));
+}
+
+// Closes an HDF5 identifier with the matching close function on scope exit.
+class Handle {
+ public:
+  Handle(hid_t id, herr_t (*close)(hid_t)) : id_(id), close_(close) {}
+  ~Handle() {
+    if (id_ >= 0) close_(id_);
+  }
+  Handle(const Handle&) = delete;
+  Handle& operator=(const Handle&) = delete;
+  operator hid_t() const { return id_; }
+  bool valid() const { return id_ >= 0; }
+
+ private:
+  hid_t id_;
+  herr_t (*close_)(hid_t);
+};
+
+void write_dataset(hid_t file, const std::filesystem::path& name, const std::string& path,
+                   hid_t file_type, hid_t memory_type, const void* data,
+                   const std::vector<std::size_t>& dims) {
+  std::vector<hsize_t> h(dims.begin(), dims.end());
+  Handle space(H5Screate_simple(static_cast<int>(h.size()), h.data(), nullptr), H5Sclose);
+  Handle lcpl(H5Pcreate(H5P_LINK_CREATE), H5Pclose);
+  H5Pset_create_intermediate_group(lcpl, 1);
+  Handle ds(H5Dcreate2(file, path.c_str(), file_type, space, lcpl, H5P_DEFAULT, H5P_DEFAULT),
+            H5Dclose);
+  if (!ds.valid()) fail(name, fmt::format("cannot create dataset {}", path));
+  if (H5Dwrite(ds, memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0)
+    fail(name, fmt::format("cannot write dataset {}", path));
+}
+
+}  // namespace
+
+H5Writer::H5Writer(std::filesystem::path final_path) : final_path_(std::move(final_path)) {
+  silence_hdf5();
+  temp_path_ = final_path_;
+  temp_path_ += fmt::format(".partial-{}", ::getpid());
+  file_ = H5Fcreate(temp_path_.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+  if (file_ < 0) fail(temp_path_, "cannot create (is the output folder writable?)");
+}
+
+H5Writer::~H5Writer() {
+  if (file_ >= 0) {
+    H5Fclose(file_);
+    std::error_code ignored;
+    std::filesystem::remove(temp_path_, ignored);
+  }
+}
+
+void H5Writer::write(const std::string& path, const double* data,
+                     const std::vector<std::size_t>& dims, const std::string& unit) {
+  write_dataset(file_, final_path_, path, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, data, dims);
+  if (!unit.empty()) attribute(path, "unit", unit);
+}
+
+void H5Writer::write(const std::string& path, const std::int64_t* data,
+                     const std::vector<std::size_t>& dims) {
+  write_dataset(file_, final_path_, path, H5T_STD_I64LE, H5T_NATIVE_INT64, data, dims);
+}
+
+void H5Writer::attribute(const std::string& object, const std::string& name,
+                         const std::string& value) {
+  Handle obj(H5Oopen(file_, object.c_str(), H5P_DEFAULT), H5Oclose);
+  if (!obj.valid()) fail(final_path_, fmt::format("no object {} for attribute {}", object, name));
+  Handle type(H5Tcopy(H5T_C_S1), H5Tclose);
+  H5Tset_size(type, std::max<std::size_t>(1, value.size()));
+  H5Tset_strpad(type, H5T_STR_NULLPAD);
+  Handle space(H5Screate(H5S_SCALAR), H5Sclose);
+  Handle attr(H5Acreate2(obj, name.c_str(), type, space, H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
+  if (!attr.valid() || H5Awrite(attr, type, value.empty() ? "" : value.data()) < 0)
+    fail(final_path_, fmt::format("cannot write attribute {} on {}", name, object));
+}
+
+void H5Writer::attribute(const std::string& object, const std::string& name, double value) {
+  Handle obj(H5Oopen(file_, object.c_str(), H5P_DEFAULT), H5Oclose);
+  if (!obj.valid()) fail(final_path_, fmt::format("no object {} for attribute {}", object, name));
+  Handle space(H5Screate(H5S_SCALAR), H5Sclose);
+  Handle attr(H5Acreate2(obj, name.c_str(), H5T_IEEE_F64LE, space, H5P_DEFAULT, H5P_DEFAULT),
+              H5Aclose);
+  if (!attr.valid() || H5Awrite(attr, H5T_NATIVE_DOUBLE, &value) < 0)
+    fail(final_path_, fmt::format("cannot write attribute {} on {}", name, object));
+}
+
+void H5Writer::commit() {
+  if (H5Fclose(file_) < 0) fail(temp_path_, "cannot close");
+  file_ = -1;
+  std::filesystem::rename(temp_path_, final_path_);
+}
+
+H5Reader::H5Reader(const std::filesystem::path& path) : path_(path) {
+  silence_hdf5();
+  file_ = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  if (file_ < 0) fail(path, "cannot open (missing, or not an HDF5 file)");
+}
+
+H5Reader::~H5Reader() {
+  if (file_ >= 0) H5Fclose(file_);
+}
+
+bool H5Reader::exists(const std::string& path) const {
+  // Check each link along the path, as H5Lexists requires.
+  std::size_t pos = 0;
+  while ((pos = path.find('/', pos + 1)) != std::string::npos)
+    if (H5Lexists(file_, path.substr(0, pos).c_str(), H5P_DEFAULT) <= 0) return false;
+  return H5Lexists(file_, path.c_str(), H5P_DEFAULT) > 0;
+}
+
+std::vector<std::size_t> H5Reader::shape(const std::string& path) const {
+  Handle ds(H5Dopen2(file_, path.c_str(), H5P_DEFAULT), H5Dclose);
+  if (!ds.valid()) fail(path_, fmt::format("no dataset {}", path));
+  Handle space(H5Dget_space(ds), H5Sclose);
+  const int rank = H5Sget_simple_extent_ndims(space);
+  std::vector<hsize_t> dims(static_cast<std::size_t>(std::max(rank, 0)));
+  H5Sget_simple_extent_dims(space, dims.data(), nullptr);
+  return {dims.begin(), dims.end()};
+}
+
+std::vector<double> H5Reader::read_doubles(const std::string& path) const {
+  std::size_t n = 1;
+  for (auto d : shape(path)) n *= d;
+  std::vector<double> data(n);
+  Handle ds(H5Dopen2(file_, path.c_str(), H5P_DEFAULT), H5Dclose);
+  if (H5Dread(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()) < 0)
+    fail(path_, fmt::format("cannot read dataset {} as numbers", path));
+  return data;
+}
+
+std::vector<std::int64_t> H5Reader::read_integers(const std::string& path) const {
+  std::size_t n = 1;
+  for (auto d : shape(path)) n *= d;
+  std::vector<std::int64_t> data(n);
+  Handle ds(H5Dopen2(file_, path.c_str(), H5P_DEFAULT), H5Dclose);
+  if (H5Dread(ds, H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()) < 0)
+    fail(path_, fmt::format("cannot read dataset {} as integers", path));
+  return data;
+}
+
+std::string H5Reader::string_attribute(const std::string& object, const std::string& name) const {
+  Handle attr(H5Aopen_by_name(file_, object.c_str(), name.c_str(), H5P_DEFAULT, H5P_DEFAULT),
+              H5Aclose);
+  if (!attr.valid()) fail(path_, fmt::format("no attribute {} on {}", name, object));
+  Handle type(H5Aget_type(attr), H5Tclose);
+  std::string value(H5Tget_size(type), '\0');
+  if (H5Aread(attr, type, value.data()) < 0)
+    fail(path_, fmt::format("cannot read attribute {} on {}", name, object));
+  while (!value.empty() && value.back() == '\0') value.pop_back();
+  return value;
+}
+
+double H5Reader::number_attribute(const std::string& object, const std::string& name) const {
+  Handle attr(H5Aopen_by_name(file_, object.c_str(), name.c_str(), H5P_DEFAULT, H5P_DEFAULT),
+              H5Aclose);
+  double v = 0;
+  if (!attr.valid() || H5Aread(attr, H5T_NATIVE_DOUBLE, &v) < 0)
+    fail(path_, fmt::format("no number attribute {} on {}", name, object));
+  return v;
+}
+
+}  // namespace outburst::hdf5

@@ -1,0 +1,115 @@
+#include "common/program.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+
+#include <CLI/CLI.hpp>
+#include <fmt/ranges.h>
+#include <cstdio>
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
+#include "common/progress.hpp"
+#include "common/version.hpp"
+
+namespace outburst {
+
+std::filesystem::path RunOptions::output_directory() const {
+  if (!output.empty()) return output;
+  return std::filesystem::path("results") / scene.stem();
+}
+
+bool RunOptions::show_progress() const { return !quiet && stderr_is_terminal(); }
+
+output::RunInfo run_info(const std::string& program, const scene::Document& doc,
+                         const std::string& units) {
+  return {program,
+          version,
+          std::filesystem::absolute(doc.file()).string(),
+          doc.text(),
+          doc.overrides(),
+          units};
+}
+
+SceneHeader read_scene_header(const scene::Table& root) {
+  const auto s = root.table("scene", "what the scene is and which solvers it runs", true);
+  SceneHeader h;
+  h.title = s->string({"title", "a one-line description, copied into the outputs", "untitled"});
+  h.solvers = s->choice_list(
+      {"solvers", "the solvers this scene runs; nothing else is built", ""}, {"seepage", "mpm"});
+  if (h.solvers.empty()) s->fail("solvers", "name at least one solver: [\"seepage\"], [\"mpm\"] or both");
+  h.end_time = s->quantity({"end_time", "simulated time at which the run stops", "", scene::Range::positive()},
+                           units::time);
+  const auto o = root.table("output", "what is written and how often", false);
+  h.output_interval = h.end_time / 10;
+  if (o && o->has("interval"))
+    h.output_interval = o->quantity({"interval", "simulated time between snapshots (default: end_time / 10)",
+                                     "", scene::Range::positive()},
+                                    units::time);
+  return h;
+}
+
+void require_solvers(const scene::Table& root, const SceneHeader& header,
+                     const std::vector<std::string>& supported, const std::string& program) {
+  for (const auto& s : header.solvers)
+    if (std::find(supported.begin(), supported.end(), s) == supported.end()) {
+      const auto scene_table = root.table("scene", "", true);
+      scene_table->fail("solvers", fmt::format("{} runs only {}; this scene also needs '{}'",
+                                               program, fmt::join(supported, " and "), s));
+    }
+}
+
+bool finish_reading(const RunOptions& options, const scene::Document& doc) {
+  doc.reject_unused();
+  if (options.explain) std::fputs(doc.explain().c_str(), stdout);
+  if (options.check_only) {
+    spdlog::info("{}: the scene is valid", doc.file().string());
+    return false;
+  }
+  return true;
+}
+
+int run_program(const std::string& program, const std::string& description, int argc, char** argv,
+                const std::function<int(const RunOptions&, scene::Document&)>& run) {
+  CLI::App app(description, program);
+  RunOptions options;
+  app.add_option("scene", options.scene, "Scene file (TOML)")->required()->check(CLI::ExistingFile);
+  app.add_option("-o,--output", options.output, "Output folder (default: results/<scene name>)");
+  app.add_option("-s,--set", options.overrides,
+                 "Override a scene key: dotted.key=<TOML value>, e.g. "
+                 "--set seepage.time_step='\"30 min\"'");
+  app.add_flag("--check", options.check_only, "Validate the scene and stop");
+  app.add_flag("--explain", options.explain,
+               "Print every key the scene uses with its value, default and meaning");
+  app.add_flag("-q,--quiet", options.quiet, "No progress line");
+  app.add_option("--log-level", options.log_level, "trace, debug, info, warn, error")
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
+  app.add_option("-j,--threads", options.threads, "OpenMP threads (default: all cores)")
+      ->check(CLI::NonNegativeNumber);
+  app.set_version_flag("--version", std::string(version));
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
+  }
+
+  auto logger = spdlog::stderr_color_mt(program);
+  logger->set_pattern("[%H:%M:%S] [%n] [%^%l%$] %v");
+  spdlog::set_default_logger(logger);
+  spdlog::set_level(spdlog::level::from_str(options.log_level));
+  if (options.threads > 0) omp_set_num_threads(options.threads);
+
+  try {
+    auto doc = scene::Document::load(options.scene, options.overrides);
+    return run(options, *doc);
+  } catch (const scene::Error& e) {
+    spdlog::error("{}", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    spdlog::error("{}", e.what());
+    return 1;
+  }
+}
+
+}  // namespace outburst

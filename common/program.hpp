@@ -1,0 +1,60 @@
+#pragma once
+// The command line shared by every program of the project:
+//
+//   <program> SCENE [--output DIR] [--set key=value]... [--check] [--explain]
+//             [--quiet] [--log-level LEVEL] [--threads N]
+//
+// and the one place that turns exceptions into exit codes: 2 for a bad scene or
+// command line (with the file, line and key), 1 for a run that failed.
+
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "common/field_output.hpp"
+#include "common/scene.hpp"
+
+namespace outburst {
+
+struct RunOptions {
+  std::filesystem::path scene;
+  std::filesystem::path output;  // empty: results/<scene name>
+  std::vector<std::string> overrides;
+  bool check_only = false;   // read and validate the scene, run nothing
+  bool explain = false;      // print every key the scene uses, with defaults
+  bool quiet = false;        // no progress line
+  std::string log_level = "info";
+  int threads = 0;           // 0: OpenMP's default
+
+  std::filesystem::path output_directory() const;
+  bool show_progress() const;
+};
+
+// Parse the command line, set up logging and threads, load the scene, and call
+// `run` with the loaded document. Returns the process exit code.
+int run_program(const std::string& program, const std::string& description, int argc, char** argv,
+                const std::function<int(const RunOptions&, scene::Document&)>& run);
+
+// The [scene] and [output] sections every scene has.
+struct SceneHeader {
+  std::string title;
+  std::vector<std::string> solvers;  // which solvers run: "seepage", "mpm"
+  double end_time;                   // [s]
+  double output_interval;            // simulated time between snapshots [s]
+};
+SceneHeader read_scene_header(const scene::Table& root);
+
+// Stops with a clear error when a program is given a scene for other solvers.
+void require_solvers(const scene::Table& root, const SceneHeader& header,
+                     const std::vector<std::string>& supported, const std::string& program);
+
+// Provenance for output files of this run.
+output::RunInfo run_info(const std::string& program, const scene::Document& doc,
+                         const std::string& units);
+
+// After reading: reject unknown keys and honour --explain / --check.
+// Returns false when the program should stop here (check only).
+bool finish_reading(const RunOptions& options, const scene::Document& doc);
+
+}  // namespace outburst

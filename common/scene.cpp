@@ -1,0 +1,540 @@
+#include "common/scene.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <functional>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <toml++/toml.h>
+
+namespace outburst::scene {
+
+namespace {
+
+std::string read_text(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw Error(fmt::format("{}: cannot open the scene file", file.string()));
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::string node_text(const toml::node& n) {
+  if (const auto* s = n.as_string()) return s->get();
+  std::ostringstream out;
+  n.visit([&](const auto& v) { out << v; });
+  return out.str();
+}
+
+std::vector<std::string_view> split_commas(std::string_view text) {
+  std::vector<std::string_view> parts;
+  while (true) {
+    const auto comma = text.find(',');
+    std::string_view part = text.substr(0, comma);
+    while (!part.empty() && part.front() == ' ') part.remove_prefix(1);
+    while (!part.empty() && part.back() == ' ') part.remove_suffix(1);
+    parts.push_back(part);
+    if (comma == std::string_view::npos) return parts;
+    text.remove_prefix(comma + 1);
+  }
+}
+
+double parse_number_text(std::string_view text) {
+  double v = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+  if (ec != std::errc() || end != text.data() + text.size())
+    throw std::logic_error(fmt::format("default '{}' is not a number", text));
+  return v;
+}
+
+std::string join(const std::vector<std::string_view>& words) {
+  std::string s;
+  for (const auto& w : words) s += fmt::format("{}\"{}\"", s.empty() ? "" : ", ", w);
+  return s;
+}
+
+// Insert `value` (TOML syntax) at a dotted path, creating tables on the way.
+void apply_override(toml::table& root, const std::string& assignment) {
+  const auto eq = assignment.find('=');
+  if (eq == std::string::npos || eq == 0)
+    throw Error(fmt::format("--set '{}': expected key=value, for example "
+                            "--set seepage.time_step='\"1 h\"'",
+                            assignment));
+  const std::string path = assignment.substr(0, eq);
+  toml::table parsed;
+  try {
+    parsed = toml::parse("v = " + assignment.substr(eq + 1), std::string_view("--set"));
+  } catch (const toml::parse_error& e) {
+    throw Error(fmt::format("--set '{}': the value is not TOML ({}); strings need quotes, "
+                            "for example --set seepage.time_step='\"1 h\"'",
+                            assignment, e.description()));
+  }
+  toml::table* target = &root;
+  std::string_view rest = path;
+  for (;;) {
+    const auto dot = rest.find('.');
+    const std::string key(rest.substr(0, dot));
+    if (dot == std::string_view::npos) {
+      parsed.get("v")->visit([&](auto& v) { target->insert_or_assign(key, v); });
+      return;
+    }
+    toml::node* next = target->get(key);
+    if (!next) next = target->insert_or_assign(key, toml::table{}).first->second.as_table();
+    if (!next->is_table())
+      throw Error(fmt::format("--set '{}': '{}' is not a table", assignment, key));
+    target = next->as_table();
+    rest.remove_prefix(dot + 1);
+  }
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------- Range
+
+bool Range::contains(double v) const {
+  if (!std::isfinite(v)) return false;
+  if (min && (min_inclusive ? v < *min : v <= *min)) return false;
+  if (max && (max_inclusive ? v > *max : v >= *max)) return false;
+  return true;
+}
+
+std::string Range::describe() const {
+  if (min && max)
+    return fmt::format("{} {:g} and {} {:g}", min_inclusive ? ">=" : ">", *min,
+                       max_inclusive ? "<=" : "<", *max);
+  if (min) return fmt::format("{} {:g}", min_inclusive ? ">=" : ">", *min);
+  if (max) return fmt::format("{} {:g}", max_inclusive ? "<=" : "<", *max);
+  return "finite";
+}
+
+// ---------------------------------------------------------------- Document
+
+std::unique_ptr<Document> Document::load(const std::filesystem::path& file,
+                                         const std::vector<std::string>& overrides) {
+  auto doc = parse(read_text(file), file.string(), overrides);
+  doc->file_ = file;
+  return doc;
+}
+
+std::unique_ptr<Document> Document::parse(std::string_view text, const std::string& name,
+                                          const std::vector<std::string>& overrides) {
+  std::unique_ptr<Document> doc(new Document());
+  doc->file_ = name;
+  doc->text_ = std::string(text);
+  doc->overrides_ = overrides;
+  try {
+    doc->root_ = std::make_unique<toml::table>(toml::parse(doc->text_, name));
+  } catch (const toml::parse_error& e) {
+    throw Error(fmt::format("{}:{}:{}: not valid TOML: {}", name, e.source().begin.line,
+                            e.source().begin.column, e.description()));
+  }
+  for (const auto& o : overrides) {
+    apply_override(*doc->root_, o);
+    doc->overridden_paths_.insert(o.substr(0, o.find('=')));
+  }
+  return doc;
+}
+
+Document::~Document() = default;
+
+Table Document::root() { return Table(this, root_.get(), ""); }
+
+void Document::mark_used(const toml::node* n) {
+  used_.insert(n);
+  if (const auto* arr = n->as_array())
+    for (const auto& child : *arr) mark_used(&child);
+}
+
+std::string Document::located(const toml::node* n, const std::string& key_path,
+                              const std::string& message) const {
+  std::string where = file_.string();
+  if (overridden_paths_.count(key_path))
+    where = "--set";
+  else if (n && n->source().begin.line > 0)
+    where = fmt::format("{}:{}:{}", file_.string(), n->source().begin.line, n->source().begin.column);
+  if (key_path.empty()) return fmt::format("{}: {}", where, message);
+  return fmt::format("{}: key '{}': {}", where, key_path, message);
+}
+
+void Document::check_unused(const toml::table& table, const std::string& path) const {
+  for (const auto& [k, v] : table) {
+    const std::string key_path = path.empty() ? std::string(k.str()) : path + "." + std::string(k.str());
+    if (!used_.count(&v)) {
+      std::string read;
+      for (const auto& [k2, v2] : table)
+        if (used_.count(&v2)) read += fmt::format("{}{}", read.empty() ? "" : ", ", k2.str());
+      const std::string section = path.empty() ? "the top level" : "[" + path + "]";
+      const std::string hint = read.empty()
+                                   ? fmt::format("nothing in {} is read by this scene's solvers",
+                                                 section)
+                                   : fmt::format("keys this scene reads in {}: {}", section, read);
+      throw Error(located(&v, key_path,
+                          fmt::format("unknown key, or a key this scene does not use ({})", hint)));
+    }
+    if (const auto* sub = v.as_table()) check_unused(*sub, key_path);
+    if (const auto* arr = v.as_array(); arr && arr->is_array_of_tables())
+      for (std::size_t i = 0; i < arr->size(); ++i)
+        check_unused(*arr->get(i)->as_table(), fmt::format("{}[{}]", key_path, i));
+  }
+}
+
+void Document::reject_unused() const { check_unused(*root_, ""); }
+
+std::string Document::explain() const {
+  std::size_t width = 0;
+  for (const auto& r : records_) width = std::max(width, r.path.size() + r.value.size() + 3);
+  std::string out;
+  for (const auto& r : records_) {
+    const std::string kv = fmt::format("{} = {}", r.path, r.value);
+    out += fmt::format("{:<{}} {} {}\n", kv, width, r.defaulted ? "(default)" : "         ",
+                       r.doc);
+  }
+  return out;
+}
+
+// ---------------------------------------------------------------- Table
+
+Table::Table(Document* doc, const toml::table* table, std::string path)
+    : doc_(doc), table_(table), path_(std::move(path)) {}
+
+std::string Table::key_path(std::string_view key) const {
+  return path_.empty() ? std::string(key) : path_ + "." + std::string(key);
+}
+
+bool Table::has(std::string_view key) const { return table_->get(key) != nullptr; }
+
+const toml::node* Table::node(std::string_view key) const {
+  const toml::node* n = table_->get(key);
+  if (n) doc_->mark_used(n);
+  return n;
+}
+
+void Table::fail(std::string_view key, const std::string& message) const {
+  const toml::node* n = table_->get(key);
+  throw Error(doc_->located(n ? n : table_, key_path(key), message));
+}
+
+const toml::node* Table::required_node(const Key& key) const {
+  const toml::node* n = node(key.name);
+  if (!n && key.fallback.empty())
+    throw Error(doc_->located(table_, key_path(key.name),
+                              fmt::format("required key is missing ({})", key.doc)));
+  return n;
+}
+
+void Table::record(const Key& key, const std::string& value, bool defaulted) const {
+  doc_->records_.push_back({key_path(key.name), value, defaulted, std::string(key.doc)});
+}
+
+namespace {
+
+units::Quantity quantity_from_text(std::string_view text, const units::Dimension& dimension,
+                                   const std::function<void(const std::string&)>& fail) {
+  units::Quantity q{};
+  try {
+    q = units::parse_quantity(text);
+  } catch (const units::UnitError& e) {
+    fail(fmt::format("expected a {} with its unit: {}", units::describe(dimension), e.what()));
+  }
+  if (!(q.dimension == dimension)) {
+    const std::string given = q.dimension == units::dimensionless
+                                  ? std::string("a bare number")
+                                  : "a " + units::describe(q.dimension);
+    fail(fmt::format("expected a {} with its unit, got \"{}\", which is {}",
+                     units::describe(dimension), text, given));
+  }
+  return q;
+}
+
+}  // namespace
+
+double Table::quantity(const Key& key, const units::Dimension& dimension) const {
+  return quantity_of(key, dimension, dimension).first;
+}
+
+std::pair<double, units::Dimension> Table::quantity_of(const Key& key,
+                                                       const units::Dimension& a,
+                                                       const units::Dimension& b) const {
+  const toml::node* n = required_node(key);
+  const std::string expected =
+      a == b ? units::describe(a)
+             : fmt::format("{} or a {}", units::describe(a), units::describe(b));
+  std::string text;
+  if (n) {
+    if (!n->is_string()) {
+      if (n->is_number())
+        fail(key.name, fmt::format("expected a {} with its unit as a string, such as \"{}\"; "
+                                   "a bare number has no unit",
+                                   expected, key.fallback.empty() ? "1 m" : key.fallback));
+      fail(key.name, fmt::format("expected a {} with its unit as a string", expected));
+    }
+    text = n->as_string()->get();
+  } else {
+    text = key.fallback;
+  }
+  units::Quantity q{};
+  try {
+    q = units::parse_quantity(text);
+  } catch (const units::UnitError& e) {
+    fail(key.name, fmt::format("expected a {} with its unit: {}", expected, e.what()));
+  }
+  if (!(q.dimension == a) && !(q.dimension == b)) {
+    const std::string given = q.dimension == units::dimensionless
+                                  ? std::string("a bare number")
+                                  : "a " + units::describe(q.dimension);
+    fail(key.name, fmt::format("expected a {} with its unit, got \"{}\", which is {}", expected,
+                               text, given));
+  }
+  if (!key.range.contains(q.si))
+    fail(key.name, fmt::format("must be {} (in SI), got \"{}\"", key.range.describe(), text));
+  record(key, text, n == nullptr);
+  return {q.si, q.dimension};
+}
+
+std::vector<double> Table::quantity_vector(const Key& key, const units::Dimension& dimension,
+                                           std::size_t count) const {
+  const toml::node* n = required_node(key);
+  std::vector<std::string> texts;
+  if (n) {
+    const auto* arr = n->as_array();
+    if (!arr || arr->size() != count)
+      fail(key.name, fmt::format("expected an array of {} {} values with units, such as "
+                                 "[\"0 m\", \"1 m\"]",
+                                 count, units::describe(dimension)));
+    for (const auto& item : *arr) {
+      if (!item.is_string())
+        fail(key.name, fmt::format("expected each entry as a {} with its unit, as a string",
+                                   units::describe(dimension)));
+      texts.push_back(item.as_string()->get());
+    }
+  } else {
+    for (auto part : split_commas(key.fallback)) texts.emplace_back(part);
+  }
+  std::vector<double> values;
+  std::string shown;
+  for (const auto& t : texts) {
+    const auto q = quantity_from_text(t, dimension, [&](const std::string& m) { fail(key.name, m); });
+    if (!key.range.contains(q.si))
+      fail(key.name, fmt::format("each entry must be {} (in SI), got \"{}\"", key.range.describe(), t));
+    values.push_back(q.si);
+    shown += fmt::format("{}\"{}\"", shown.empty() ? "" : ", ", t);
+  }
+  record(key, "[" + shown + "]", n == nullptr);
+  return values;
+}
+
+double Table::number(const Key& key) const {
+  const toml::node* n = required_node(key);
+  double v = 0;
+  if (n) {
+    if (n->is_string())
+      fail(key.name, fmt::format("expected a plain number (dimensionless), got the string \"{}\"",
+                                 n->as_string()->get()));
+    const auto value = n->value<double>();
+    if (!value) fail(key.name, "expected a number");
+    v = *value;
+  } else {
+    v = parse_number_text(key.fallback);
+  }
+  if (!key.range.contains(v))
+    fail(key.name, fmt::format("must be {}, got {:g}", key.range.describe(), v));
+  record(key, n ? node_text(*n) : std::string(key.fallback), n == nullptr);
+  return v;
+}
+
+long Table::integer(const Key& key) const {
+  const toml::node* n = required_node(key);
+  long v = 0;
+  if (n) {
+    if (!n->is_integer()) fail(key.name, fmt::format("expected an integer, got {}", node_text(*n)));
+    v = static_cast<long>(n->as_integer()->get());
+  } else {
+    v = static_cast<long>(parse_number_text(key.fallback));
+  }
+  if (!key.range.contains(static_cast<double>(v)))
+    fail(key.name, fmt::format("must be {}, got {}", key.range.describe(), v));
+  record(key, std::to_string(v), n == nullptr);
+  return v;
+}
+
+std::vector<long> Table::integer_vector(const Key& key, std::size_t count) const {
+  const toml::node* n = required_node(key);
+  std::vector<long> values;
+  if (n) {
+    const auto* arr = n->as_array();
+    if (!arr || arr->size() != count)
+      fail(key.name, fmt::format("expected an array of {} integers", count));
+    for (const auto& item : *arr) {
+      if (!item.is_integer()) fail(key.name, fmt::format("expected an array of {} integers", count));
+      values.push_back(static_cast<long>(item.as_integer()->get()));
+    }
+  } else {
+    for (auto part : split_commas(key.fallback))
+      values.push_back(static_cast<long>(parse_number_text(part)));
+  }
+  std::string shown;
+  for (long v : values) {
+    if (!key.range.contains(static_cast<double>(v)))
+      fail(key.name, fmt::format("each entry must be {}, got {}", key.range.describe(), v));
+    shown += fmt::format("{}{}", shown.empty() ? "" : ", ", v);
+  }
+  record(key, "[" + shown + "]", n == nullptr);
+  return values;
+}
+
+std::vector<double> Table::number_vector(const Key& key, std::size_t count) const {
+  const toml::node* n = required_node(key);
+  std::vector<double> values;
+  if (n) {
+    const auto* arr = n->as_array();
+    if (!arr || arr->size() != count)
+      fail(key.name, fmt::format("expected an array of {} numbers", count));
+    for (const auto& item : *arr) {
+      const auto v = item.value<double>();
+      if (!v || item.is_string()) fail(key.name, fmt::format("expected an array of {} numbers", count));
+      values.push_back(*v);
+    }
+  } else {
+    for (auto part : split_commas(key.fallback)) values.push_back(parse_number_text(part));
+  }
+  std::string shown;
+  for (double v : values) {
+    if (!key.range.contains(v))
+      fail(key.name, fmt::format("each entry must be {}, got {:g}", key.range.describe(), v));
+    shown += fmt::format("{}{:g}", shown.empty() ? "" : ", ", v);
+  }
+  record(key, "[" + shown + "]", n == nullptr);
+  return values;
+}
+
+bool Table::boolean(const Key& key) const {
+  const toml::node* n = required_node(key);
+  bool v = key.fallback == "true";
+  if (n) {
+    if (!n->is_boolean()) fail(key.name, fmt::format("expected true or false, got {}", node_text(*n)));
+    v = n->as_boolean()->get();
+  }
+  record(key, v ? "true" : "false", n == nullptr);
+  return v;
+}
+
+std::string Table::string(const Key& key) const {
+  const toml::node* n = required_node(key);
+  std::string v(key.fallback);
+  if (n) {
+    if (!n->is_string()) fail(key.name, fmt::format("expected a string, got {}", node_text(*n)));
+    v = n->as_string()->get();
+  }
+  record(key, "\"" + v + "\"", n == nullptr);
+  return v;
+}
+
+std::string Table::choice(const Key& key, const std::vector<std::string_view>& choices) const {
+  const toml::node* n = required_node(key);
+  std::string v(key.fallback);
+  if (n) {
+    if (!n->is_string())
+      fail(key.name, fmt::format("expected one of {}, got {}", join(choices), node_text(*n)));
+    v = n->as_string()->get();
+  }
+  if (std::find(choices.begin(), choices.end(), v) == choices.end())
+    fail(key.name, fmt::format("expected one of {}, got \"{}\"", join(choices), v));
+  record(key, "\"" + v + "\"", n == nullptr);
+  return v;
+}
+
+std::vector<std::string> Table::choice_list(const Key& key,
+                                            const std::vector<std::string_view>& choices) const {
+  const toml::node* n = required_node(key);
+  std::vector<std::string> values;
+  if (n) {
+    const auto* arr = n->as_array();
+    if (!arr) fail(key.name, fmt::format("expected an array of words from {}", join(choices)));
+    for (const auto& item : *arr) {
+      if (!item.is_string())
+        fail(key.name, fmt::format("expected an array of words from {}", join(choices)));
+      values.push_back(item.as_string()->get());
+    }
+  } else {
+    for (auto part : split_commas(key.fallback))
+      if (!part.empty()) values.emplace_back(part);
+  }
+  std::string shown;
+  for (const auto& v : values) {
+    if (std::find(choices.begin(), choices.end(), v) == choices.end())
+      fail(key.name, fmt::format("\"{}\" is not one of {}", v, join(choices)));
+    if (std::count(values.begin(), values.end(), v) > 1)
+      fail(key.name, fmt::format("\"{}\" is listed twice", v));
+    shown += fmt::format("{}\"{}\"", shown.empty() ? "" : ", ", v);
+  }
+  record(key, "[" + shown + "]", n == nullptr);
+  return values;
+}
+
+std::filesystem::path Table::file(const Key& key) const {
+  const std::string text = string(key);
+  std::filesystem::path p(text);
+  if (p.is_relative()) p = doc_->file().parent_path() / p;
+  if (!std::filesystem::exists(p))
+    fail(key.name, fmt::format("the file \"{}\" does not exist (looked for {})", text, p.string()));
+  return p;
+}
+
+TimeFunction Table::time_function(const Key& key, const units::Dimension& dimension) const {
+  const toml::node* n = table_->get(key.name);
+  if (!n || n->is_string()) return TimeFunction(quantity(key, dimension));
+  node(key.name);
+  const auto* arr = n->as_array();
+  const std::string form = fmt::format(
+      "expected a {} with its unit (\"0.1 MPa\") or a table of [time, value] pairs "
+      "([[\"0 s\", \"3 MPa\"], [\"10 s\", \"0.1 MPa\"]])",
+      units::describe(dimension));
+  if (!arr || arr->empty()) fail(key.name, form);
+  std::vector<std::pair<double, double>> points;
+  for (const auto& item : *arr) {
+    const auto* pair = item.as_array();
+    if (!pair || pair->size() != 2 || !pair->get(0)->is_string() || !pair->get(1)->is_string())
+      fail(key.name, form);
+    const auto fail_here = [&](const std::string& m) { fail(key.name, m); };
+    const double t = quantity_from_text(pair->get(0)->as_string()->get(), units::time, fail_here).si;
+    const double v =
+        quantity_from_text(pair->get(1)->as_string()->get(), dimension, fail_here).si;
+    if (!points.empty() && t <= points.back().first)
+      fail(key.name, "the times of the [time, value] pairs must increase strictly");
+    if (!key.range.contains(v))
+      fail(key.name, fmt::format("every value must be {} (in SI), got \"{}\"", key.range.describe(),
+                                 pair->get(1)->as_string()->get()));
+    points.emplace_back(t, v);
+  }
+  record(key, node_text(*n), false);
+  return TimeFunction(std::move(points));
+}
+
+std::optional<Table> Table::table(std::string_view key, std::string_view doc, bool required) const {
+  const toml::node* n = node(key);
+  if (!n) {
+    if (required)
+      throw Error(doc_->located(table_, key_path(key),
+                                fmt::format("required section [{}] is missing ({})", key_path(key), doc)));
+    return std::nullopt;
+  }
+  if (!n->is_table()) fail(key, fmt::format("expected a section (a TOML table): {}", doc));
+  return Table(doc_, n->as_table(), key_path(key));
+}
+
+std::vector<Table> Table::table_array(std::string_view key, std::string_view doc) const {
+  const toml::node* n = node(key);
+  std::vector<Table> tables;
+  if (!n) return tables;
+  const auto* arr = n->as_array();
+  if (!arr || !arr->is_array_of_tables())
+    fail(key, fmt::format("expected an array of tables, written [[{}]]: {}", key_path(key), doc));
+  for (std::size_t i = 0; i < arr->size(); ++i)
+    tables.emplace_back(doc_, arr->get(i)->as_table(), fmt::format("{}[{}]", key_path(key), i));
+  return tables;
+}
+
+}  // namespace outburst::scene

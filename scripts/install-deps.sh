@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# Installs what the project needs from Debian 12's packages, and only what is
+# missing. Idempotent; run as root (or with sudo available).
+set -euo pipefail
+
+packages=(
+  # build
+  cmake g++ make git pkg-config
+  # numerics: Eigen, CHOLMOD on OpenBLAS (the Debian alternatives pick OpenBLAS
+  # over the 4-8x slower reference BLAS once it is installed)
+  libeigen3-dev libsuitesparse-dev libopenblas-dev
+  # output, scene files, command line, logging, tests
+  libhdf5-dev libtomlplusplus-dev libcli11-dev libspdlog-dev libfmt-dev catch2
+  # figures, and ParaView's Python for checking that our output opens
+  python3 python3-matplotlib python3-numpy python3-h5py python3-paraview
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#packages[@]} packages present"
+  exit 0
+fi
+
+echo "install-deps: installing ${missing[*]}"
+sudo_cmd=()
+[ "$(id -u)" -eq 0 ] || sudo_cmd=(sudo)
+export DEBIAN_FRONTEND=noninteractive
+"${sudo_cmd[@]}" apt-get update -q
+"${sudo_cmd[@]}" apt-get install -y -q --no-install-recommends "${missing[@]}"

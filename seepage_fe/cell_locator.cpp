@@ -1,0 +1,70 @@
+#include "seepage_fe/cell_locator.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "seepage_fe/q1.hpp"
+
+namespace outburst::seepage {
+
+namespace {
+
+q1::Corners corners(const Mesh& mesh, int cell) {
+  const auto& c = mesh.cells[static_cast<std::size_t>(cell)];
+  return {mesh.nodes[c[0]], mesh.nodes[c[1]], mesh.nodes[c[2]], mesh.nodes[c[3]]};
+}
+
+}  // namespace
+
+CellLocator::CellLocator(const Mesh& mesh) : mesh_(mesh) {
+  Eigen::Vector2d lo = mesh.nodes.front(), hi = mesh.nodes.front();
+  for (const auto& p : mesh.nodes) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  // About one cell per bucket on average, in buckets matching the domain's shape.
+  const Eigen::Vector2d extent = (hi - lo).cwiseMax(1e-12);
+  const double cells = static_cast<double>(mesh.num_cells());
+  const double aspect = extent.x() / extent.y();
+  nx_ = std::max(1, static_cast<int>(std::sqrt(cells * aspect)));
+  ny_ = std::max(1, static_cast<int>(cells / nx_));
+  lower_ = lo;
+  bucket_size_ = extent.cwiseQuotient(Eigen::Vector2d(nx_, ny_));
+
+  std::vector<std::vector<int>> buckets(static_cast<std::size_t>(nx_) * ny_);
+  for (std::size_t c = 0; c < mesh.num_cells(); ++c) {
+    Eigen::Vector2d clo = mesh.nodes[mesh.cells[c][0]], chi = clo;
+    for (int k = 1; k < 4; ++k) {
+      clo = clo.cwiseMin(mesh.nodes[mesh.cells[c][k]]);
+      chi = chi.cwiseMax(mesh.nodes[mesh.cells[c][k]]);
+    }
+    const auto index = [&](const Eigen::Vector2d& p, int axis, int n) {
+      return std::clamp(static_cast<int>((p[axis] - lower_[axis]) / bucket_size_[axis]), 0, n - 1);
+    };
+    for (int j = index(clo, 1, ny_); j <= index(chi, 1, ny_); ++j)
+      for (int i = index(clo, 0, nx_); i <= index(chi, 0, nx_); ++i)
+        buckets[static_cast<std::size_t>(j) * nx_ + i].push_back(static_cast<int>(c));
+  }
+  bucket_start_.push_back(0);
+  for (const auto& b : buckets) {
+    bucket_cells_.insert(bucket_cells_.end(), b.begin(), b.end());
+    bucket_start_.push_back(static_cast<int>(bucket_cells_.size()));
+  }
+}
+
+std::optional<CellLocator::Hit> CellLocator::locate(const Eigen::Vector2d& point) const {
+  const Eigen::Vector2d rel = (point - lower_).cwiseQuotient(bucket_size_);
+  const double tol = 1e-9;
+  if (rel.x() < -tol || rel.y() < -tol || rel.x() > nx_ + tol || rel.y() > ny_ + tol)
+    return std::nullopt;
+  const int i = std::clamp(static_cast<int>(rel.x()), 0, nx_ - 1);
+  const int j = std::clamp(static_cast<int>(rel.y()), 0, ny_ - 1);
+  const int b = j * nx_ + i;
+  for (int k = bucket_start_[b]; k < bucket_start_[b + 1]; ++k) {
+    const int cell = bucket_cells_[k];
+    if (const auto ref = q1::inverse_map(corners(mesh_, cell), point)) return Hit{cell, *ref};
+  }
+  return std::nullopt;
+}
+
+}  // namespace outburst::seepage

@@ -1,0 +1,34 @@
+#pragma once
+// Finds the cell holding a point, for reading the pressure at arbitrary places
+// (particle positions in the coupled runs). A uniform bucket grid over the cells'
+// bounding boxes makes a query O(1) on any mesh; the exact test is the inverse
+// isoparametric map of the few candidate cells.
+
+#include <optional>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "seepage_fe/mesh.hpp"
+
+namespace outburst::seepage {
+
+class CellLocator {
+ public:
+  explicit CellLocator(const Mesh& mesh);
+
+  struct Hit {
+    int cell;
+    Eigen::Vector2d reference;  // coordinates in [-1, 1]^2
+  };
+  std::optional<Hit> locate(const Eigen::Vector2d& point) const;
+
+ private:
+  const Mesh& mesh_;
+  Eigen::Vector2d lower_, bucket_size_;
+  int nx_ = 1, ny_ = 1;
+  std::vector<int> bucket_start_;  // CSR layout: cells of bucket b are
+  std::vector<int> bucket_cells_;  // bucket_cells_[bucket_start_[b] .. bucket_start_[b+1])
+};
+
+}  // namespace outburst::seepage

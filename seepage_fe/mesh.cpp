@@ -1,0 +1,375 @@
+#include "seepage_fe/mesh.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+#include <unordered_map>
+
+#include <fmt/format.h>
+
+namespace outburst::seepage {
+
+int Mesh::region_index(const std::string& name) const {
+  for (std::size_t i = 0; i < region_names.size(); ++i)
+    if (region_names[i] == name) return static_cast<int>(i);
+  return -1;
+}
+
+const Mesh::Boundary* Mesh::boundary(const std::string& name) const {
+  for (const auto& b : boundaries)
+    if (b.name == name) return &b;
+  return nullptr;
+}
+
+std::vector<std::string> Mesh::boundary_names() const {
+  std::vector<std::string> names;
+  for (const auto& b : boundaries) names.push_back(b.name);
+  return names;
+}
+
+namespace {
+
+// Node coordinates along one direction with geometric grading: successive cell
+// sizes grow by r = grading^(1/(n-1)), so the last cell is `grading` times the first.
+std::vector<double> graded_coordinates(double start, double length, int n, double grading) {
+  std::vector<double> x(static_cast<std::size_t>(n) + 1);
+  const double r = n > 1 ? std::pow(grading, 1.0 / (n - 1)) : 1.0;
+  std::vector<double> widths(static_cast<std::size_t>(n));
+  double sum = 0;
+  for (int i = 0; i < n; ++i) sum += widths[i] = std::pow(r, i);
+  x[0] = start;
+  for (int i = 0; i < n; ++i) x[i + 1] = x[i] + length * widths[i] / sum;
+  x[n] = start + length;
+  return x;
+}
+
+}  // namespace
+
+Mesh make_structured_mesh(const StructuredMeshSpec& spec) {
+  const int nx = spec.cells[0], ny = spec.cells[1];
+  const auto xs = graded_coordinates(spec.origin.x(), spec.size.x(), nx, spec.grading[0]);
+  const auto ys = graded_coordinates(spec.origin.y(), spec.size.y(), ny, spec.grading[1]);
+  Mesh mesh;
+  const auto id = [nx](int i, int j) { return j * (nx + 1) + i; };
+  for (int j = 0; j <= ny; ++j)
+    for (int i = 0; i <= nx; ++i) mesh.nodes.emplace_back(xs[i], ys[j]);
+  for (const auto& r : spec.regions) mesh.region_names.push_back(r.name);
+  for (int j = 0; j < ny; ++j) {
+    for (int i = 0; i < nx; ++i) {
+      mesh.cells.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)});
+      const Eigen::Vector2d centre(0.5 * (xs[i] + xs[i + 1]), 0.5 * (ys[j] + ys[j + 1]));
+      int region = -1;
+      for (std::size_t r = 0; r < spec.regions.size(); ++r) {
+        const auto& reg = spec.regions[r];
+        if (reg.whole_domain || ((centre.array() >= reg.box_min.array()).all() &&
+                                 (centre.array() <= reg.box_max.array()).all()))
+          region = static_cast<int>(r);
+      }
+      if (region < 0)
+        throw std::invalid_argument(fmt::format(
+            "the cell centred at ({:g} m, {:g} m) lies in no region's box; give one region "
+            "without a box to cover the whole mesh, or widen the boxes",
+            centre.x(), centre.y()));
+      mesh.cell_region.push_back(region);
+    }
+  }
+  Mesh::Boundary left{"left", {}}, right{"right", {}}, bottom{"bottom", {}}, top{"top", {}};
+  for (int j = 0; j < ny; ++j) {
+    left.edges.push_back({id(0, j + 1), id(0, j)});
+    right.edges.push_back({id(nx, j), id(nx, j + 1)});
+  }
+  for (int i = 0; i < nx; ++i) {
+    bottom.edges.push_back({id(i, 0), id(i + 1, 0)});
+    top.edges.push_back({id(i + 1, ny), id(i, ny)});
+  }
+  mesh.boundaries = {left, right, bottom, top};
+  return mesh;
+}
+
+namespace {
+
+// Whitespace-separated tokens with the line each came from, for error messages.
+class MshReader {
+ public:
+  MshReader(const std::filesystem::path& file) : file_(file), in_(file) {
+    if (!in_) throw std::runtime_error(fmt::format("{}: cannot open the mesh file", file.string()));
+  }
+
+  [[noreturn]] void fail(const std::string& what) const {
+    throw std::runtime_error(fmt::format("{}:{}: {}", file_.string(), line_, what));
+  }
+
+  bool next_line(std::string& line) {
+    if (!std::getline(in_, line)) return false;
+    ++line_;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    return true;
+  }
+
+  // The next non-empty line, split into tokens.
+  std::vector<std::string> tokens(const char* expected) {
+    std::string line;
+    do {
+      if (!next_line(line)) fail(fmt::format("the file ends early; expected {}", expected));
+    } while (line.find_first_not_of(" \t") == std::string::npos);
+    std::istringstream s(line);
+    std::vector<std::string> t;
+    for (std::string w; s >> w;) t.push_back(w);
+    return t;
+  }
+
+  long integer(const std::string& token, const char* what) const {
+    try {
+      std::size_t used = 0;
+      const long v = std::stol(token, &used);
+      if (used == token.size()) return v;
+    } catch (const std::exception&) {
+    }
+    fail(fmt::format("expected {} (an integer), got '{}'", what, token));
+  }
+
+  double number(const std::string& token, const char* what) const {
+    try {
+      std::size_t used = 0;
+      const double v = std::stod(token, &used);
+      if (used == token.size()) return v;
+    } catch (const std::exception&) {
+    }
+    fail(fmt::format("expected {} (a number), got '{}'", what, token));
+  }
+
+  void expect_count(const std::vector<std::string>& t, std::size_t n, const char* what) const {
+    if (t.size() < n) fail(fmt::format("expected {} ({} values), got {}", what, n, t.size()));
+  }
+
+  void expect_end(const char* section) {
+    const auto t = tokens(section);
+    if (t.empty() || t[0] != section) fail(fmt::format("expected {}", section));
+  }
+
+  int line() const { return line_; }
+
+ private:
+  std::filesystem::path file_;
+  std::ifstream in_;
+  int line_ = 0;
+};
+
+const char* element_name(long type) {
+  switch (type) {
+    case 1: return "2-node line";
+    case 2: return "3-node triangle";
+    case 3: return "4-node quadrangle";
+    case 8: return "3-node line";
+    case 9: return "6-node triangle";
+    case 10: return "9-node quadrangle";
+    case 15: return "point";
+    case 16: return "8-node quadrangle";
+    default: return "element";
+  }
+}
+
+}  // namespace
+
+Mesh read_gmsh(const std::filesystem::path& file, double length_scale) {
+  MshReader r(file);
+  std::map<std::pair<int, int>, std::string> physical_names;  // (dim, tag) -> name
+  std::map<std::pair<int, int>, int> entity_physical;         // (dim, entity) -> physical tag
+  std::unordered_map<long, Eigen::Vector2d> node_xy;
+  struct RawCell {
+    std::array<long, 4> tags;
+    int physical;
+  };
+  struct RawEdge {
+    std::array<long, 2> tags;
+    int physical;
+  };
+  std::vector<RawCell> raw_cells;
+  std::vector<RawEdge> raw_edges;
+  bool seen_format = false, seen_nodes = false, seen_elements = false;
+
+  std::string line;
+  while (r.next_line(line)) {
+    if (line.empty()) continue;
+    if (line == "$MeshFormat") {
+      const auto t = r.tokens("the MSH version line");
+      r.expect_count(t, 3, "the version line 'version file-type data-size'");
+      if (t[0] != "4.1")
+        r.fail(fmt::format("MSH format {} is not supported; save the mesh as MSH 4.1 "
+                           "(gmsh -format msh41, or Mesh.MshFileVersion = 4.1)",
+                           t[0]));
+      if (t[1] != "0") r.fail("binary MSH is not supported; save as ASCII (Mesh.Binary = 0)");
+      r.expect_end("$EndMeshFormat");
+      seen_format = true;
+    } else if (line == "$PhysicalNames") {
+      const long n = r.integer(r.tokens("the number of physical names")[0], "the number of names");
+      for (long i = 0; i < n; ++i) {
+        auto t = r.tokens("a physical name 'dimension tag \"name\"'");
+        r.expect_count(t, 3, "a physical name 'dimension tag \"name\"'");
+        std::string name = t[2];
+        for (std::size_t k = 3; k < t.size(); ++k) name += " " + t[k];
+        if (name.size() >= 2 && name.front() == '"' && name.back() == '"')
+          name = name.substr(1, name.size() - 2);
+        physical_names[{static_cast<int>(r.integer(t[0], "a dimension")),
+                        static_cast<int>(r.integer(t[1], "a physical tag"))}] = name;
+      }
+      r.expect_end("$EndPhysicalNames");
+    } else if (line == "$Entities") {
+      const auto counts = r.tokens("the entity counts");
+      r.expect_count(counts, 4, "the entity counts 'points curves surfaces volumes'");
+      for (int dim = 0; dim < 4; ++dim) {
+        const long n = r.integer(counts[dim], "an entity count");
+        for (long i = 0; i < n; ++i) {
+          const auto t = r.tokens("an entity");
+          // Points carry x y z before their physical tags; the others a bounding box.
+          const std::size_t at = dim == 0 ? 4 : 7;
+          r.expect_count(t, at + 1, "an entity record");
+          const long tag = r.integer(t[0], "an entity tag");
+          const long physicals = r.integer(t[at], "the number of physical tags");
+          if (physicals > 0) {
+            r.expect_count(t, at + 2, "the entity's physical tags");
+            entity_physical[{dim, static_cast<int>(tag)}] =
+                static_cast<int>(std::abs(r.integer(t[at + 1], "a physical tag")));
+          }
+        }
+      }
+      r.expect_end("$EndEntities");
+    } else if (line == "$Nodes") {
+      const auto head = r.tokens("the node block header");
+      r.expect_count(head, 4, "'numEntityBlocks numNodes minNodeTag maxNodeTag'");
+      const long blocks = r.integer(head[0], "the number of node blocks");
+      for (long b = 0; b < blocks; ++b) {
+        const auto bh = r.tokens("a node block header");
+        r.expect_count(bh, 4, "'entityDim entityTag parametric numNodesInBlock'");
+        const long n = r.integer(bh[3], "the number of nodes in the block");
+        if (bh[2] != "0") r.fail("parametric node coordinates are not supported");
+        std::vector<long> tags(static_cast<std::size_t>(n));
+        for (long i = 0; i < n; ++i) tags[i] = r.integer(r.tokens("a node tag")[0], "a node tag");
+        for (long i = 0; i < n; ++i) {
+          const auto c = r.tokens("node coordinates 'x y z'");
+          r.expect_count(c, 3, "node coordinates 'x y z'");
+          node_xy[tags[i]] = Eigen::Vector2d(r.number(c[0], "x"), r.number(c[1], "y")) * length_scale;
+        }
+      }
+      r.expect_end("$EndNodes");
+      seen_nodes = true;
+    } else if (line == "$Elements") {
+      const auto head = r.tokens("the element block header");
+      r.expect_count(head, 4, "'numEntityBlocks numElements minElementTag maxElementTag'");
+      const long blocks = r.integer(head[0], "the number of element blocks");
+      for (long b = 0; b < blocks; ++b) {
+        const auto bh = r.tokens("an element block header");
+        r.expect_count(bh, 4, "'entityDim entityTag elementType numElementsInBlock'");
+        const int dim = static_cast<int>(r.integer(bh[0], "an entity dimension"));
+        const int entity = static_cast<int>(r.integer(bh[1], "an entity tag"));
+        const long type = r.integer(bh[2], "an element type");
+        const long n = r.integer(bh[3], "the number of elements in the block");
+        const auto phys = entity_physical.find({dim, entity});
+        if (dim == 2 && type != 3)
+          r.fail(fmt::format("surface {} holds {}s; the seepage solver needs 4-node "
+                             "quadrangles (add 'Recombine Surface{{...}};' to the .geo file)",
+                             entity, element_name(type)));
+        if (dim == 2 && phys == entity_physical.end())
+          r.fail(fmt::format("surface {} belongs to no physical group, so its cells would have "
+                             "no region; add it to a 'Physical Surface'",
+                             entity));
+        for (long i = 0; i < n; ++i) {
+          const auto t = r.tokens("an element record");
+          if (dim == 2) {
+            r.expect_count(t, 5, "a quadrangle 'tag n1 n2 n3 n4'");
+            raw_cells.push_back({{r.integer(t[1], "a node tag"), r.integer(t[2], "a node tag"),
+                                  r.integer(t[3], "a node tag"), r.integer(t[4], "a node tag")},
+                                 phys->second});
+          } else if (dim == 1 && phys != entity_physical.end()) {
+            if (type != 1)
+              r.fail(fmt::format("curve {} holds {}s; only 2-node lines are supported", entity,
+                                 element_name(type)));
+            r.expect_count(t, 3, "a line 'tag n1 n2'");
+            raw_edges.push_back(
+                {{r.integer(t[1], "a node tag"), r.integer(t[2], "a node tag")}, phys->second});
+          }
+        }
+      }
+      r.expect_end("$EndElements");
+      seen_elements = true;
+    }
+  }
+  if (!seen_format) r.fail("no $MeshFormat section: this is not a Gmsh MSH file");
+  if (!seen_nodes || !seen_elements) r.fail("the file has no $Nodes or no $Elements section");
+  if (raw_cells.empty()) r.fail("the mesh has no quadrangles in any physical surface");
+
+  // Keep only nodes that cells use (Gmsh also stores geometry points), numbered
+  // in order of first use.
+  Mesh mesh;
+  std::unordered_map<long, int> index;
+  std::map<int, int> region_of_physical;
+  const auto node_index = [&](long tag) {
+    const auto found = index.find(tag);
+    if (found != index.end()) return found->second;
+    const auto xy = node_xy.find(tag);
+    if (xy == node_xy.end())
+      throw std::runtime_error(
+          fmt::format("{}: an element uses node {}, which $Nodes does not define", file.string(), tag));
+    const int i = static_cast<int>(mesh.nodes.size());
+    mesh.nodes.push_back(xy->second);
+    index[tag] = i;
+    return i;
+  };
+  for (const auto& c : raw_cells) {
+    std::array<int, 4> cell{};
+    for (int k = 0; k < 4; ++k) cell[k] = node_index(c.tags[k]);
+    const auto [it, added] =
+        region_of_physical.try_emplace(c.physical, static_cast<int>(mesh.region_names.size()));
+    if (added) {
+      const auto name = physical_names.find({2, c.physical});
+      mesh.region_names.push_back(name != physical_names.end() ? name->second
+                                                               : fmt::format("{}", c.physical));
+    }
+    // Gmsh orients quads by the surface normal; we need counter-clockwise in x-y.
+    const auto& p = mesh.nodes;
+    const double twice_area = (p[cell[2]] - p[cell[0]]).x() * (p[cell[3]] - p[cell[1]]).y() -
+                              (p[cell[2]] - p[cell[0]]).y() * (p[cell[3]] - p[cell[1]]).x();
+    if (twice_area < 0) std::swap(cell[1], cell[3]);
+    mesh.cells.push_back(cell);
+    mesh.cell_region.push_back(it->second);
+  }
+  std::map<int, std::size_t> boundary_of_physical;
+  for (const auto& e : raw_edges) {
+    const auto a = index.find(e.tags[0]), b = index.find(e.tags[1]);
+    if (a == index.end() || b == index.end())
+      throw std::runtime_error(fmt::format(
+          "{}: a boundary line uses node {} or {}, which no quadrangle uses", file.string(),
+          e.tags[0], e.tags[1]));
+    const auto [it, added] = boundary_of_physical.try_emplace(e.physical, mesh.boundaries.size());
+    if (added) {
+      const auto name = physical_names.find({1, e.physical});
+      mesh.boundaries.push_back(
+          {name != physical_names.end() ? name->second : fmt::format("{}", e.physical), {}});
+    }
+    mesh.boundaries[it->second].edges.push_back({a->second, b->second});
+  }
+  check_mesh(mesh, file.string());
+  return mesh;
+}
+
+void check_mesh(const Mesh& mesh, const std::string& source) {
+  for (std::size_t c = 0; c < mesh.cells.size(); ++c) {
+    const auto& cell = mesh.cells[c];
+    for (int k = 0; k < 4; ++k) {
+      const Eigen::Vector2d a = mesh.nodes[cell[(k + 1) % 4]] - mesh.nodes[cell[k]];
+      const Eigen::Vector2d b = mesh.nodes[cell[(k + 3) % 4]] - mesh.nodes[cell[k]];
+      const double cross = a.x() * b.y() - a.y() * b.x();
+      if (!(cross > 0))
+        throw std::runtime_error(fmt::format(
+            "{}: cell {} (nodes at ({:g}, {:g}), ({:g}, {:g}), ({:g}, {:g}), ({:g}, {:g})) is "
+            "degenerate or not convex at its corner {}",
+            source, c, mesh.nodes[cell[0]].x(), mesh.nodes[cell[0]].y(), mesh.nodes[cell[1]].x(),
+            mesh.nodes[cell[1]].y(), mesh.nodes[cell[2]].x(), mesh.nodes[cell[2]].y(),
+            mesh.nodes[cell[3]].x(), mesh.nodes[cell[3]].y(), k));
+    }
+  }
+}
+
+}  // namespace outburst::seepage

@@ -1,0 +1,53 @@
+#include "seepage_fe/output.hpp"
+
+#include <fmt/format.h>
+
+namespace outburst::seepage {
+
+Output::Output(const std::filesystem::path& directory, const output::RunInfo& info,
+               const Solver& solver)
+    : series_(directory, "seepage", info) {
+  const Mesh& mesh = solver.mesh();
+  std::vector<double> xyz;
+  for (const auto& p : mesh.nodes) xyz.insert(xyz.end(), {p.x(), p.y(), 0.0});
+  std::vector<std::int64_t> quads;
+  for (const auto& c : mesh.cells) quads.insert(quads.end(), c.begin(), c.end());
+  series_.add_quad_mesh("mesh", xyz, quads);
+
+  history_.open(directory / "seepage_history.csv", std::ios::trunc);
+  history_ << "step,time_s,dt_s,substeps,cuts,iterations,stored_m3_per_m,inflow_flux_m3_per_m";
+  for (const auto& b : solver.balance().pressure_boundaries) history_ << ",inflow_" << b << "_m3_per_m";
+  history_ << ",balance_error_relative\n";
+  history_.flush();
+}
+
+void Output::snapshot(const Solver& solver) {
+  const bool gas = solver.model().law == Law::gas;
+  output::Snapshot snap(solver.time());
+  snap.add("mesh", {"p", output::Center::node, 1, "Pa", solver.nodal_pressure()});
+  if (gas) {
+    const auto& u = solver.unknown();
+    snap.add("mesh", {"P", output::Center::node, 1, "Pa^2", {u.data(), u.data() + u.size()}});
+  }
+  snap.add("mesh", {gas ? "lambda" : "mobility", output::Center::cell, 1,
+                    gas ? "m^2/(Pa^2 s)" : "m^2/(Pa s)", solver.conductivity()});
+  std::vector<double> flux;
+  for (const auto& q : solver.cell_flux()) flux.insert(flux.end(), {q.x(), q.y(), 0.0});
+  snap.add("mesh", {"flux", output::Center::cell, 3, gas ? "m/s (standard gas volume)" : "m/s", flux});
+  const auto& regions = solver.mesh().cell_region;
+  snap.add("mesh", {"region", output::Center::cell, 1, "", {regions.begin(), regions.end()}});
+  series_.write(snap);
+}
+
+void Output::history(const Solver& solver, double dt, const StepReport& report) {
+  const Balance& b = solver.balance();
+  std::string line = fmt::format("{},{:.17g},{:.17g},{},{},{},{:.17g},{:.17g}", solver.steps(),
+                                 solver.time(), dt, report.substeps, report.cuts,
+                                 report.nonlinear_iterations, b.stored, b.inflow_through_flux);
+  for (double v : b.inflow_through_pressure) line += fmt::format(",{:.17g}", v);
+  line += fmt::format(",{:.6e}\n", b.initial_stored > 0 ? b.error() / b.initial_stored : b.error());
+  history_ << line;
+  history_.flush();
+}
+
+}  // namespace outburst::seepage

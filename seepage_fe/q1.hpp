@@ -1,0 +1,91 @@
+#pragma once
+// The bilinear quadrilateral (Q1): shape functions on the reference square
+// [-1, 1]^2, the isoparametric map, and the element integrals the solver needs.
+
+#include <array>
+#include <optional>
+
+#include <Eigen/Core>
+#include <Eigen/LU>
+
+namespace outburst::seepage::q1 {
+
+using Corners = std::array<Eigen::Vector2d, 4>;
+
+// Reference corner coordinates, counter-clockwise from (-1, -1).
+inline constexpr double corner_xi[4] = {-1, 1, 1, -1};
+inline constexpr double corner_eta[4] = {-1, -1, 1, 1};
+
+inline std::array<double, 4> shape(double xi, double eta) {
+  std::array<double, 4> n{};
+  for (int a = 0; a < 4; ++a) n[a] = 0.25 * (1 + corner_xi[a] * xi) * (1 + corner_eta[a] * eta);
+  return n;
+}
+
+// Shape functions and their x-y gradients at one reference point.
+struct Point {
+  std::array<double, 4> n;
+  std::array<Eigen::Vector2d, 4> grad;
+  double det_j;
+};
+
+inline Point evaluate(const Corners& x, double xi, double eta) {
+  Point p{shape(xi, eta), {}, 0.0};
+  std::array<Eigen::Vector2d, 4> dref;
+  Eigen::Matrix2d jac = Eigen::Matrix2d::Zero();  // d(x, y) / d(xi, eta)
+  for (int a = 0; a < 4; ++a) {
+    dref[a] = {0.25 * corner_xi[a] * (1 + corner_eta[a] * eta),
+               0.25 * corner_eta[a] * (1 + corner_xi[a] * xi)};
+    jac += x[a] * dref[a].transpose();
+  }
+  p.det_j = jac.determinant();
+  const Eigen::Matrix2d inv_t = jac.inverse().transpose();
+  for (int a = 0; a < 4; ++a) p.grad[a] = inv_t * dref[a];
+  return p;
+}
+
+// 2x2 Gauss rule, exact for the bilinear stiffness on parallelograms.
+inline constexpr double gauss2 = 0.57735026918962576451;  // 1/sqrt(3)
+inline constexpr std::array<std::array<double, 2>, 4> gauss2_points{
+    {{-gauss2, -gauss2}, {gauss2, -gauss2}, {gauss2, gauss2}, {-gauss2, gauss2}}};
+
+struct Integrals {
+  Eigen::Matrix4d stiffness;  // int grad N_a . grad N_b dA (unit conductivity)
+  Eigen::Vector4d lumped;     // int N_a dA (row sums of the consistent mass)
+};
+
+inline Integrals integrals(const Corners& x) {
+  Integrals r{Eigen::Matrix4d::Zero(), Eigen::Vector4d::Zero()};
+  for (const auto& g : gauss2_points) {
+    const Point p = evaluate(x, g[0], g[1]);
+    for (int a = 0; a < 4; ++a) {
+      r.lumped[a] += p.n[a] * p.det_j;
+      for (int b = 0; b < 4; ++b) r.stiffness(a, b) += p.grad[a].dot(p.grad[b]) * p.det_j;
+    }
+  }
+  return r;
+}
+
+// Reference coordinates of `point` in the cell, or nullopt if it lies outside
+// (with a small tolerance so points on shared edges are found).
+inline std::optional<Eigen::Vector2d> inverse_map(const Corners& x, const Eigen::Vector2d& point) {
+  Eigen::Vector2d ref = Eigen::Vector2d::Zero();
+  for (int it = 0; it < 20; ++it) {
+    const auto n = shape(ref.x(), ref.y());
+    Eigen::Vector2d mapped = Eigen::Vector2d::Zero();
+    Eigen::Matrix2d jac = Eigen::Matrix2d::Zero();
+    for (int a = 0; a < 4; ++a) {
+      mapped += n[a] * x[a];
+      jac += x[a] * Eigen::RowVector2d(0.25 * corner_xi[a] * (1 + corner_eta[a] * ref.y()),
+                                        0.25 * corner_eta[a] * (1 + corner_xi[a] * ref.x()));
+    }
+    const Eigen::Vector2d step = jac.inverse() * (point - mapped);
+    ref += step;
+    if (step.lpNorm<Eigen::Infinity>() < 1e-13) break;
+    if (ref.lpNorm<Eigen::Infinity>() > 10) return std::nullopt;
+  }
+  if (ref.lpNorm<Eigen::Infinity>() > 1 + 1e-9) return std::nullopt;
+  return ref.cwiseMax(-1.0).cwiseMin(1.0);
+}
+
+}  // namespace outburst::seepage::q1

@@ -1,0 +1,200 @@
+#include "seepage_fe/scene_reader.hpp"
+
+#include <limits>
+#include <variant>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+namespace outburst::seepage {
+
+using scene::Key;
+using scene::Range;
+
+namespace {
+
+// A Gmsh mesh is read at once; a structured one is returned as its spec so the
+// regions can be painted into it before it is generated.
+std::variant<Mesh, StructuredMeshSpec> read_mesh(const scene::Table& t) {
+  const std::string type =
+      t.choice({"type", "\"structured\": a generated rectangle; \"gmsh\": a quad mesh file",
+                "structured"},
+               {"structured", "gmsh"});
+  if (type == "gmsh") {
+    const auto file = t.file({"file", "Gmsh MSH 4.1 ASCII file, relative to the scene file"});
+    const double scale = t.quantity(
+        {"length_unit", "length of one coordinate unit in the mesh file", "1 m", Range::positive()},
+        units::length);
+    try {
+      return read_gmsh(file, scale);
+    } catch (const std::runtime_error& e) {
+      t.fail("file", e.what());
+    }
+  }
+  StructuredMeshSpec spec;
+  const auto origin = t.quantity_vector({"origin", "lower-left corner", "0 m, 0 m"}, units::length, 2);
+  const auto size = t.quantity_vector({"size", "width and height", "", Range::positive()}, units::length, 2);
+  const auto cells = t.integer_vector({"cells", "number of cells along x and y", "", Range::at_least(1)}, 2);
+  const auto grading = t.number_vector(
+      {"grading", "ratio of the last to the first cell size along x and y (1: uniform)", "1, 1",
+       Range::positive()},
+      2);
+  spec.origin = {origin[0], origin[1]};
+  spec.size = {size[0], size[1]};
+  spec.cells = {static_cast<int>(cells[0]), static_cast<int>(cells[1])};
+  spec.grading = {grading[0], grading[1]};
+  return spec;
+}
+
+Material read_material(const scene::Table& r, Law law) {
+  Material m{};
+  if (law == Law::gas) {
+    m.conductivity = r.quantity({"lambda",
+                                 "gas permeability coefficient in q = -lambda grad(p^2), e.g. "
+                                 "\"0.1 m2/(MPa2 d)\"",
+                                 "", Range::positive()},
+                                units::gas_conductivity);
+    const auto [a, dimension] = r.quantity_of(
+        {"gas_content_coefficient",
+         "A in X = A sqrt(p): per coal volume (\"2 MPa^-0.5\") or per coal mass "
+         "(\"1.25 m3/(t MPa^0.5)\", needs coal_density)",
+         "", Range::positive()},
+        units::gas_content_per_volume, units::gas_content_per_mass);
+    m.capacity = a;
+    if (dimension == units::gas_content_per_mass)
+      m.capacity *= r.quantity({"coal_density",
+                                "coal density, converting a per-mass gas content coefficient",
+                                "", Range::positive()},
+                               units::density);
+  } else {
+    const double k = r.quantity({"permeability", "intrinsic permeability", "", Range::positive()},
+                                units::area);
+    const double mu = r.quantity(
+        {"viscosity", "fluid dynamic viscosity", "1e-3 Pa s", Range::positive()}, units::viscosity);
+    m.conductivity = k / mu;
+    m.capacity = r.quantity({"storage_coefficient",
+                             "S in S dp/dt = div((k/mu) grad p): specific storage per pressure",
+                             "", Range::positive()},
+                            units::inverse_pressure);
+  }
+  m.initial_pressure = r.quantity(
+      {"initial_pressure", "pressure at t = 0",
+       "", law == Law::gas ? Range::positive() : Range{}},
+      units::pressure);
+  return m;
+}
+
+}  // namespace
+
+Setup read_setup(const scene::Table& s) {
+  Setup setup;
+  Model& model = setup.model;
+  model.law = s.choice({"law",
+                        "\"gas\": P = p^2 with gas content A sqrt(p) (the paper's); \"linear\": "
+                        "Darcy flow of a slightly compressible fluid, unknown p",
+                        "gas"},
+                       {"gas", "linear"}) == "gas"
+                  ? Law::gas
+                  : Law::linear;
+
+  Settings& st = setup.settings;
+  st.scheme = s.choice({"time_scheme", "\"bdf2\" (second order, L-stable) or \"backward_euler\"",
+                        "bdf2"},
+                       {"bdf2", "backward_euler"}) == "bdf2"
+                  ? TimeScheme::bdf2
+                  : TimeScheme::backward_euler;
+  st.method = s.choice({"nonlinear_solver",
+                        "\"newton\" (with line search) or \"picard\" (secant storage)", "newton"},
+                       {"newton", "picard"}) == "newton"
+                  ? NonlinearMethod::newton
+                  : NonlinearMethod::picard;
+  st.tolerance = s.number({"tolerance", "nonlinear convergence: max |du| / max |u|", "1e-10",
+                           Range::positive()});
+  st.max_iterations = static_cast<int>(s.integer(
+      {"max_iterations", "nonlinear iterations before the step is cut", "30", Range::at_least(1)}));
+  st.max_step_cuts = static_cast<int>(s.integer(
+      {"max_step_cuts", "halvings of a failing step before the run stops", "12", Range::at_least(0)}));
+
+  setup.steps.first = s.quantity({"time_step", "first time step", "", Range::positive()}, units::time);
+  setup.steps.growth = s.number({"time_step_growth",
+                                 "factor between successive steps (1: constant; up to 2)", "1",
+                                 Range::between(1, 2)});
+  setup.steps.maximum = std::numeric_limits<double>::infinity();
+  if (s.has("max_time_step"))
+    setup.steps.maximum = s.quantity(
+        {"max_time_step", "largest step when time_step_growth > 1", "", Range::positive()}, units::time);
+
+  auto mesh_or_spec = read_mesh(*s.table("mesh", "the finite element mesh", true));
+
+  // Regions: on a generated mesh, boxes paint regions over the rectangle; on a
+  // Gmsh mesh, each physical surface must have a region of the same name.
+  const auto regions = s.table_array("regions", "materials and initial pressure per region");
+  if (regions.empty())
+    s.fail("regions", "give at least one [[seepage.regions]] with its material and initial pressure");
+  Mesh& mesh = setup.mesh;
+  if (auto* spec = std::get_if<StructuredMeshSpec>(&mesh_or_spec)) {
+    for (const auto& r : regions) {
+      StructuredMeshSpec::Region region;
+      region.name = r.string({"name", "region name (used in output and messages)"});
+      region.whole_domain = !r.has("box_min");
+      if (!region.whole_domain) {
+        const auto lo = r.quantity_vector({"box_min", "lower-left corner of the region's box"}, units::length, 2);
+        const auto hi = r.quantity_vector({"box_max", "upper-right corner of the region's box"}, units::length, 2);
+        region.box_min = {lo[0], lo[1]};
+        region.box_max = {hi[0], hi[1]};
+      }
+      spec->regions.push_back(region);
+      model.materials.push_back(read_material(r, model.law));
+    }
+    try {
+      mesh = make_structured_mesh(*spec);
+    } catch (const std::invalid_argument& e) {
+      s.fail("regions", e.what());
+    }
+  } else {
+    mesh = std::move(std::get<Mesh>(mesh_or_spec));
+    model.materials.resize(mesh.region_names.size());
+    std::vector<bool> given(mesh.region_names.size(), false);
+    for (const auto& r : regions) {
+      const std::string name = r.string({"name", "a physical surface name of the Gmsh mesh"});
+      const int index = mesh.region_index(name);
+      if (index < 0)
+        r.fail("name", fmt::format("the mesh has no physical surface \"{}\" (it has: {})", name,
+                                   fmt::join(mesh.region_names, ", ")));
+      if (given[index]) r.fail("name", fmt::format("region \"{}\" is given twice", name));
+      given[index] = true;
+      model.materials[index] = read_material(r, model.law);
+    }
+    for (std::size_t i = 0; i < given.size(); ++i)
+      if (!given[i])
+        s.fail("regions", fmt::format("the mesh's physical surface \"{}\" has no [[seepage.regions]] "
+                                      "entry",
+                                      mesh.region_names[i]));
+  }
+
+  for (const auto& b : s.table_array("boundaries", "boundary conditions (others: no flow)")) {
+    BoundaryCondition bc;
+    bc.boundary = b.string({"name", "a boundary of the mesh: left, right, bottom, top on a "
+                                    "generated mesh, a physical curve name on a Gmsh mesh"});
+    if (!mesh.boundary(bc.boundary))
+      b.fail("name", fmt::format("the mesh has no boundary \"{}\" (it has: {})", bc.boundary,
+                                 fmt::join(mesh.boundary_names(), ", ")));
+    bc.type = b.choice({"type", "\"pressure\" (fixed p) or \"flux\" (prescribed inflow)"},
+                       {"pressure", "flux"}) == "pressure"
+                  ? BoundaryCondition::Type::pressure
+                  : BoundaryCondition::Type::flux;
+    if (bc.type == BoundaryCondition::Type::pressure)
+      bc.value = b.time_function({"value", "boundary pressure p, constant or [[time, p], ...]", "",
+                                  model.law == Law::gas ? Range::positive() : Range{}},
+                                 units::pressure);
+    else
+      bc.value = b.time_function({"value",
+                                  "inflow per boundary area, positive into the domain "
+                                  "(standard gas volume for the gas law)"},
+                                 units::velocity);
+    model.boundary_conditions.push_back(bc);
+  }
+  return setup;
+}
+
+}  // namespace outburst::seepage

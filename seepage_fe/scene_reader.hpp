@@ -1,0 +1,27 @@
+#pragma once
+// Reads the [seepage] section of a scene into a mesh, a model, solver settings
+// and the time-step control. Run `seepage-fe SCENE --explain` to see every key a
+// scene uses with its value, unit, default and meaning.
+
+#include "common/scene.hpp"
+#include "seepage_fe/mesh.hpp"
+#include "seepage_fe/model.hpp"
+
+namespace outburst::seepage {
+
+struct TimeStepControl {
+  double first;        // [s]
+  double growth;       // each step is this factor longer than the last
+  double maximum;      // [s]
+};
+
+struct Setup {
+  Mesh mesh;
+  Model model;
+  Settings settings;
+  TimeStepControl steps;
+};
+
+Setup read_setup(const scene::Table& seepage);
+
+}  // namespace outburst::seepage

@@ -1,0 +1,485 @@
+#include "seepage_fe/solver.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numeric>
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include "common/blas.hpp"
+#include "seepage_fe/q1.hpp"
+
+namespace outburst::seepage {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+constexpr std::size_t supernodal_threshold = 20000;
+
+// Adds the wall time of its scope to a counter.
+class ScopedTimer {
+ public:
+  explicit ScopedTimer(double& total) : total_(total), start_(Clock::now()) {}
+  ~ScopedTimer() { total_ += std::chrono::duration<double>(Clock::now() - start_).count(); }
+
+ private:
+  double& total_;
+  Clock::time_point start_;
+};
+
+q1::Corners corners(const Mesh& mesh, std::size_t cell) {
+  const auto& c = mesh.cells[cell];
+  return {mesh.nodes[c[0]], mesh.nodes[c[1]], mesh.nodes[c[2]], mesh.nodes[c[3]]};
+}
+
+}  // namespace
+
+double Balance::error() const {
+  double inflow = inflow_through_flux;
+  for (double v : inflow_through_pressure) inflow += v;
+  return stored - initial_stored - inflow;
+}
+
+double Balance::total_outflow() const {
+  return -std::accumulate(inflow_through_pressure.begin(), inflow_through_pressure.end(), 0.0);
+}
+
+Solver::Solver(Mesh mesh, Model model, Settings settings)
+    : mesh_(std::move(mesh)),
+      model_(std::move(model)),
+      settings_(settings),
+      locator_(mesh_) {
+  if (model_.materials.size() != mesh_.region_names.size())
+    throw std::invalid_argument(fmt::format("the mesh has {} regions but the model {} materials",
+                                            mesh_.region_names.size(), model_.materials.size()));
+  setup_system();
+
+  // Initial state: each node takes the mean initial pressure of the cells around it.
+  const std::size_t n = mesh_.num_nodes();
+  Eigen::VectorXd sum = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n));
+  Eigen::VectorXd count = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n));
+  for (std::size_t c = 0; c < mesh_.num_cells(); ++c)
+    for (int node : mesh_.cells[c]) {
+      sum[node] += model_.materials[mesh_.cell_region[c]].initial_pressure;
+      count[node] += 1;
+    }
+  u_.resize(static_cast<Eigen::Index>(n));
+  for (Eigen::Index i = 0; i < u_.size(); ++i)
+    u_[i] = unknown_from_pressure(model_.law, sum[i] / count[i]);
+  u_previous_ = u_;
+
+  for (std::size_t k = 0; k < model_.boundary_conditions.size(); ++k)
+    if (model_.boundary_conditions[k].type == BoundaryCondition::Type::pressure)
+      balance_.pressure_boundaries.push_back(model_.boundary_conditions[k].boundary);
+  balance_.inflow_through_pressure.assign(balance_.pressure_boundaries.size(), 0.0);
+  last_inflow_pressure_.assign(balance_.pressure_boundaries.size(), 0.0);
+  for (Eigen::Index i = 0; i < u_.size(); ++i)
+    balance_.initial_stored += capacity_[i] * storage_x(model_.law, u_[i]);
+  balance_.stored = balance_.initial_stored;
+}
+
+void Solver::setup_system() {
+  const std::size_t n = mesh_.num_nodes(), nc = mesh_.num_cells();
+  cell_stiffness_.resize(nc);
+  capacity_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n));
+  conductivity_.resize(nc);
+  std::vector<Eigen::Triplet<double>> pattern;
+  pattern.reserve(nc * 16);
+  for (std::size_t c = 0; c < nc; ++c) {
+    const auto integrals = q1::integrals(corners(mesh_, c));
+    cell_stiffness_[c] = integrals.stiffness;
+    const Material& m = model_.materials[mesh_.cell_region[c]];
+    conductivity_[c] = m.conductivity;
+    for (int a = 0; a < 4; ++a) {
+      capacity_[mesh_.cells[c][a]] += m.capacity * integrals.lumped[a];
+      for (int b = 0; b < 4; ++b) pattern.emplace_back(mesh_.cells[c][a], mesh_.cells[c][b], 0.0);
+    }
+  }
+  stiffness_.resize(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(n));
+  stiffness_.setFromTriplets(pattern.begin(), pattern.end());
+  stiffness_.makeCompressed();
+
+  // Where each (row, column) of each cell lands in the compressed value array,
+  // so assembly is a plain scatter with no search.
+  const auto value_index = [&](int row, int col) {
+    const int* begin = stiffness_.innerIndexPtr() + stiffness_.outerIndexPtr()[col];
+    const int* end = stiffness_.innerIndexPtr() + stiffness_.outerIndexPtr()[col + 1];
+    return static_cast<int>(std::lower_bound(begin, end, row) - stiffness_.innerIndexPtr());
+  };
+  scatter_.resize(nc);
+  for (std::size_t c = 0; c < nc; ++c)
+    for (int a = 0; a < 4; ++a)
+      for (int b = 0; b < 4; ++b)
+        scatter_[c][4 * a + b] = value_index(mesh_.cells[c][a], mesh_.cells[c][b]);
+  diagonal_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) diagonal_[i] = value_index(static_cast<int>(i), static_cast<int>(i));
+
+  // Pressure conditions fix nodes; the first condition listed wins at corners.
+  fixed_by_.assign(n, -1);
+  pressure_bc_slot_.assign(model_.boundary_conditions.size(), -1);
+  int slot = 0;
+  for (std::size_t k = 0; k < model_.boundary_conditions.size(); ++k) {
+    const auto& bc = model_.boundary_conditions[k];
+    const auto* boundary = mesh_.boundary(bc.boundary);
+    if (!boundary) throw std::invalid_argument(fmt::format("no boundary named '{}'", bc.boundary));
+    if (bc.type != BoundaryCondition::Type::pressure) continue;
+    pressure_bc_slot_[k] = slot++;
+    for (const auto& edge : boundary->edges)
+      for (int node : edge)
+        if (fixed_by_[node] < 0) fixed_by_[node] = static_cast<int>(k);
+  }
+  for (Eigen::Index col = 0; col < stiffness_.outerSize(); ++col)
+    for (int k = stiffness_.outerIndexPtr()[col]; k < stiffness_.outerIndexPtr()[col + 1]; ++k) {
+      const int row = stiffness_.innerIndexPtr()[k];
+      if (row == col && fixed_by_[row] >= 0)
+        dirichlet_diagonal_.push_back(k);
+      else if (row != col && (fixed_by_[row] >= 0 || fixed_by_[col] >= 0))
+        dirichlet_zero_.push_back(k);
+    }
+
+  jacobian_ = stiffness_;
+  assemble_conductivity();
+  // Supernodal CHOLMOD pays off on large systems; below that its OpenMP regions
+  // (Debian builds it with OpenMP) and BLAS calls cost more than the work, and
+  // the simplicial factorisation is several times faster.
+  blas::set_threads_for(static_cast<long>(n));
+  factor_.setMode(n >= supernodal_threshold ? Eigen::CholmodSupernodalLLt : Eigen::CholmodSimplicialLLt);
+  factor_.analyzePattern(jacobian_);
+  const std::size_t size = n;
+  for (auto* v : {&trial_, &history_, &load_, &r_, &delta_, &candidate_})
+    v->setZero(static_cast<Eigen::Index>(size));
+}
+
+void Solver::assemble_conductivity() {
+  ScopedTimer timer(timings_.assembly);
+  double* values = stiffness_.valuePtr();
+  std::fill(values, values + stiffness_.nonZeros(), 0.0);
+  for (std::size_t c = 0; c < mesh_.num_cells(); ++c) {
+    const double k = conductivity_[c];
+    const double* ke = cell_stiffness_[c].data();  // column-major, symmetric
+    for (int e = 0; e < 16; ++e) values[scatter_[c][e]] += k * ke[e];
+  }
+  ++conductivity_version_;
+}
+
+void Solver::set_conductivity(const std::vector<double>& per_cell) {
+  if (per_cell.size() != mesh_.num_cells())
+    throw std::invalid_argument(fmt::format("set_conductivity: {} values for {} cells",
+                                            per_cell.size(), mesh_.num_cells()));
+  for (std::size_t c = 0; c < per_cell.size(); ++c)
+    if (!(per_cell[c] > 0) || !std::isfinite(per_cell[c]))
+      throw std::invalid_argument(
+          fmt::format("set_conductivity: cell {} gets {}, expected a positive finite value", c,
+                      per_cell[c]));
+  conductivity_ = per_cell;
+  assemble_conductivity();
+}
+
+void Solver::set_initial_pressure(const std::vector<double>& nodal_p) {
+  if (steps_ > 0) throw std::logic_error("set_initial_pressure: the run has already started");
+  if (nodal_p.size() != mesh_.num_nodes())
+    throw std::invalid_argument(fmt::format("set_initial_pressure: {} values for {} nodes",
+                                            nodal_p.size(), mesh_.num_nodes()));
+  balance_.initial_stored = 0;
+  for (Eigen::Index i = 0; i < u_.size(); ++i) {
+    u_[i] = unknown_from_pressure(model_.law, nodal_p[i]);
+    if (model_.law == Law::gas && !(nodal_p[i] > 0))
+      throw std::invalid_argument(fmt::format("set_initial_pressure: node {} gets p = {}; the gas law needs p > 0", i, nodal_p[i]));
+    balance_.initial_stored += capacity_[i] * storage_x(model_.law, u_[i]);
+  }
+  u_previous_ = u_;
+  balance_.stored = balance_.initial_stored;
+}
+
+void Solver::set_boundary_values(double t, Eigen::VectorXd& u) const {
+  for (std::size_t i = 0; i < fixed_by_.size(); ++i)
+    if (fixed_by_[i] >= 0)
+      u[static_cast<Eigen::Index>(i)] =
+          unknown_from_pressure(model_.law, model_.boundary_conditions[fixed_by_[i]].value(t));
+}
+
+void Solver::load_vector(double t, Eigen::VectorXd& f) const {
+  f.setZero();
+  for (const auto& bc : model_.boundary_conditions) {
+    if (bc.type != BoundaryCondition::Type::flux) continue;
+    const double q = bc.value(t);
+    if (q == 0) continue;
+    for (const auto& edge : mesh_.boundary(bc.boundary)->edges) {
+      const double half = 0.5 * (mesh_.nodes[edge[1]] - mesh_.nodes[edge[0]]).norm();
+      f[edge[0]] += q * half;
+      f[edge[1]] += q * half;
+    }
+  }
+  if (!source_) return;
+  for (std::size_t c = 0; c < mesh_.num_cells(); ++c) {
+    const auto x = corners(mesh_, c);
+    for (const auto& g : q1::gauss2_points) {
+      const auto p = q1::evaluate(x, g[0], g[1]);
+      Eigen::Vector2d at = Eigen::Vector2d::Zero();
+      for (int a = 0; a < 4; ++a) at += p.n[a] * x[a];
+      const double s = source_(at, t) * p.det_j;
+      for (int a = 0; a < 4; ++a) f[mesh_.cells[c][a]] += p.n[a] * s;
+    }
+  }
+}
+
+// r = c (a0 X(u) + history) + h (K u - f); returns the norm over free nodes.
+// The full vector (fixed rows included) stays in r_ for the boundary reactions;
+// residual_scale_ is the size of the terms that cancel in it (storage and flux),
+// so that a residual at round-off of those terms counts as converged.
+double Solver::residual(const Eigen::VectorXd& u, double a0, double h) {
+  ScopedTimer timer(timings_.residual);
+  ++timings_.residual_evaluations;
+  r_.noalias() = h * (stiffness_ * u);
+  const Law law = model_.law;
+  double norm2 = 0, scale2 = 0;
+  for (Eigen::Index i = 0; i < u.size(); ++i) {
+    const double stored = capacity_[i] * a0 * storage_x(law, u[i]);
+    const double flux = h * stiffness_.valuePtr()[diagonal_[i]] * u[i];
+    if (fixed_by_[i] < 0) scale2 += stored * stored + flux * flux;
+    r_[i] += stored + capacity_[i] * history_[i] - h * load_[i];
+    if (fixed_by_[i] < 0) norm2 += r_[i] * r_[i];
+  }
+  residual_scale_ = std::sqrt(scale2);
+  return std::sqrt(norm2);
+}
+
+void Solver::build_jacobian(const Eigen::VectorXd& u, double a0, double h) {
+  ScopedTimer timer(timings_.jacobian);
+  const Law law = model_.law;
+  double* j = jacobian_.valuePtr();
+  const double* k = stiffness_.valuePtr();
+  const Eigen::Index nnz = stiffness_.nonZeros();
+  for (Eigen::Index e = 0; e < nnz; ++e) j[e] = h * k[e];
+  for (Eigen::Index i = 0; i < u.size(); ++i) {
+    double slope = storage_dx(law, u[i]);
+    if (settings_.method == NonlinearMethod::picard) {
+      // Secant through the previous time level: a fixed point whose solution is
+      // the same conservative discrete equation Newton solves.
+      const double du = u[i] - u_[i];
+      if (std::abs(du) > 1e-12 * std::abs(u[i]))
+        slope = (storage_x(law, u[i]) - storage_x(law, u_[i])) / du;
+    }
+    j[diagonal_[i]] += a0 * capacity_[i] * slope;
+  }
+  for (int e : dirichlet_zero_) j[e] = 0.0;
+  for (int e : dirichlet_diagonal_) j[e] = 1.0;
+}
+
+std::optional<std::string> Solver::try_step(double h, int& iterations) {
+  double a0 = 1, a1 = -1, a2 = 0;
+  if (settings_.scheme == TimeScheme::bdf2 && has_previous_) {
+    const double w = h / dt_previous_;
+    a0 = (1 + 2 * w) / (1 + w);
+    a1 = -(1 + w);
+    a2 = w * w / (1 + w);
+  }
+  const Law law = model_.law;
+  const double t_new = time_ + h;
+  for (Eigen::Index i = 0; i < u_.size(); ++i)
+    history_[i] = a1 * storage_x(law, u_[i]) + a2 * storage_x(law, u_previous_[i]);
+  load_vector(t_new, load_);
+  trial_ = u_;
+  set_boundary_values(t_new, trial_);
+
+  double norm = residual(trial_, a0, h);
+  const bool linear = law == Law::linear;
+  // The update criterion needs one more iteration to confirm convergence; a
+  // residual this small relative to its terms needs none.
+  const double residual_tolerance = 1e-2 * settings_.tolerance;
+  for (iterations = 1; iterations <= settings_.max_iterations; ++iterations) {
+    ++timings_.nonlinear_iterations;
+    // A linear law's Jacobian depends only on h, a0 and k: keep its factorisation.
+    const bool reuse = linear && factor_key_.h == h && factor_key_.a0 == a0 &&
+                       factor_key_.version == conductivity_version_;
+    if (!reuse) {
+      build_jacobian(trial_, a0, h);
+      {
+        ScopedTimer timer(timings_.factorization);
+        factor_.factorize(jacobian_);
+        ++timings_.factorizations;
+      }
+      if (factor_.info() != Eigen::Success) {
+        factor_key_ = {};
+        return "the Jacobian is not positive definite (CHOLMOD could not factorise it)";
+      }
+      factor_key_ = linear ? FactorKey{h, a0, conductivity_version_} : FactorKey{};
+    }
+    {
+      ScopedTimer timer(timings_.solve);
+      for (Eigen::Index i = 0; i < r_.size(); ++i)
+        if (fixed_by_[i] >= 0) r_[i] = 0;
+      delta_ = factor_.solve(-r_);
+    }
+    if (!delta_.allFinite()) return "the Newton update is not finite";
+
+    // Keep the gas law's P positive: never step more than 90% of the way to zero.
+    double alpha = 1.0;
+    if (law == Law::gas)
+      for (Eigen::Index i = 0; i < delta_.size(); ++i)
+        if (delta_[i] < 0) alpha = std::min(alpha, 0.9 * trial_[i] / -delta_[i]);
+
+    double trial_norm = 0;
+    for (int halving = 0;; ++halving) {
+      candidate_ = trial_ + alpha * delta_;
+      trial_norm = residual(candidate_, a0, h);
+      // Newton must reduce the residual (Armijo); Picard's secant direction need
+      // not, so it only keeps positivity.
+      if (settings_.method == NonlinearMethod::picard || trial_norm <= (1 - 1e-4 * alpha) * norm ||
+          trial_norm <= residual_tolerance * residual_scale_)
+        break;
+      if (halving == 12)
+        return fmt::format("the line search found no decrease of the residual ({:.3e}) after 12 "
+                           "halvings of the Newton step",
+                           norm);
+      alpha *= 0.5;
+    }
+    const double update = alpha * delta_.lpNorm<Eigen::Infinity>();
+    trial_.swap(candidate_);
+    norm = trial_norm;
+    if (!std::isfinite(norm)) return "the residual is not finite";
+    if (update <= settings_.tolerance * trial_.lpNorm<Eigen::Infinity>() ||
+        norm <= residual_tolerance * residual_scale_) {
+      // r_ holds the residual of the accepted iterate, fixed rows included.
+      accept_step(h, a0, a2);
+      return std::nullopt;
+    }
+  }
+  iterations = settings_.max_iterations;
+  return fmt::format("no convergence in {} {} iterations (residual {:.3e})",
+                     settings_.max_iterations,
+                     settings_.method == NonlinearMethod::newton ? "Newton" : "Picard", norm);
+}
+
+// The step converged: update the balance and shift the time levels.
+//
+// Summing the discrete equation over all nodes (sum_i (K u)_i = 0) gives
+//   a0 dS(n+1) - a2 dS(n) = h F + rho
+// with dS the change of stored gas over a step, F the prescribed inflow and rho
+// the reactions of the fixed nodes. The inflow of each step is therefore the
+// scheme's own quadrature I(n+1) = (a2 I(n) + h F + rho) / a0 (for backward
+// Euler simply h F + rho), which keeps stored + inflow exact for BDF2 as well.
+void Solver::accept_step(double h, double a0, double a2) {
+  std::vector<double> rho(last_inflow_pressure_.size(), 0.0);
+  for (Eigen::Index i = 0; i < r_.size(); ++i)
+    if (fixed_by_[i] >= 0) rho[pressure_bc_slot_[fixed_by_[i]]] += r_[i];
+  for (std::size_t b = 0; b < rho.size(); ++b) {
+    last_inflow_pressure_[b] = (a2 * last_inflow_pressure_[b] + rho[b]) / a0;
+    balance_.inflow_through_pressure[b] += last_inflow_pressure_[b];
+  }
+  last_inflow_flux_ = (a2 * last_inflow_flux_ + h * load_.sum()) / a0;
+  balance_.inflow_through_flux += last_inflow_flux_;
+
+  u_previous_.swap(u_);
+  u_.swap(trial_);
+  dt_previous_ = h;
+  has_previous_ = true;
+  time_ += h;
+  ++steps_;
+  double stored = 0;
+  for (Eigen::Index i = 0; i < u_.size(); ++i) stored += capacity_[i] * storage_x(model_.law, u_[i]);
+  balance_.stored = stored;
+}
+
+StepReport Solver::advance(double dt) {
+  if (!(dt > 0)) throw std::invalid_argument(fmt::format("advance: dt = {} is not positive", dt));
+  ScopedTimer timer(timings_.total_step);
+  StepReport report;
+  const double t_end = time_ + dt;
+  double h = dt;
+  report.smallest_substep = dt;
+  int cuts_in_a_row = 0;
+  while (time_ < t_end * (1 - 1e-14) - 1e-300) {
+    h = std::min(h, t_end - time_);
+    int iterations = 0;
+    const auto failure = try_step(h, iterations);
+    report.nonlinear_iterations += iterations;
+    if (!failure) {
+      ++report.substeps;
+      report.smallest_substep = std::min(report.smallest_substep, h);
+      cuts_in_a_row = 0;
+      h *= 2;  // grow back after a cut; BDF2 stays zero-stable for ratios below 2.4
+      continue;
+    }
+    ++report.cuts;
+    if (++cuts_in_a_row > settings_.max_step_cuts)
+      throw StepFailure(fmt::format(
+          "seepage: the step from t = {:.6g} s could not be completed: {}. It was halved {} times "
+          "down to dt = {:.3g} s. Check that boundary pressures stay positive and consistent "
+          "with the initial state, or start with a smaller seepage.time_step.",
+          time_, *failure, settings_.max_step_cuts, h));
+    spdlog::debug("seepage: step of {:.3g} s at t = {:.6g} s failed ({}); halving", h, time_,
+                  *failure);
+    h *= 0.5;
+  }
+  return report;
+}
+
+std::optional<double> Solver::pressure_at(const Eigen::Vector2d& x) const {
+  const auto hit = locator_.locate(x);
+  if (!hit) return std::nullopt;
+  const auto n = q1::shape(hit->reference.x(), hit->reference.y());
+  double u = 0;
+  for (int a = 0; a < 4; ++a) u += n[a] * u_[mesh_.cells[hit->cell][a]];
+  return pressure_from_unknown(model_.law, u);
+}
+
+std::optional<Eigen::Vector2d> Solver::pressure_gradient_at(const Eigen::Vector2d& x) const {
+  const auto hit = locator_.locate(x);
+  if (!hit) return std::nullopt;
+  const auto p = q1::evaluate(corners(mesh_, static_cast<std::size_t>(hit->cell)),
+                              hit->reference.x(), hit->reference.y());
+  double u = 0;
+  Eigen::Vector2d grad = Eigen::Vector2d::Zero();
+  for (int a = 0; a < 4; ++a) {
+    const double ua = u_[mesh_.cells[hit->cell][a]];
+    u += p.n[a] * ua;
+    grad += p.grad[a] * ua;
+  }
+  if (model_.law == Law::linear) return grad;
+  // grad p = grad P / (2 p)
+  return grad / (2.0 * std::sqrt(std::max(u, 1e-300)));
+}
+
+std::vector<double> Solver::nodal_pressure() const {
+  std::vector<double> p(static_cast<std::size_t>(u_.size()));
+  for (Eigen::Index i = 0; i < u_.size(); ++i) p[i] = pressure_from_unknown(model_.law, u_[i]);
+  return p;
+}
+
+std::vector<Eigen::Vector2d> Solver::cell_flux() const {
+  std::vector<Eigen::Vector2d> q(mesh_.num_cells());
+  for (std::size_t c = 0; c < mesh_.num_cells(); ++c) {
+    const auto p = q1::evaluate(corners(mesh_, c), 0.0, 0.0);
+    Eigen::Vector2d grad = Eigen::Vector2d::Zero();
+    for (int a = 0; a < 4; ++a) grad += p.grad[a] * u_[mesh_.cells[c][a]];
+    q[c] = -conductivity_[c] * grad;
+  }
+  return q;
+}
+
+Solver::State Solver::save_state() const {
+  return {time_,         steps_,          u_,       u_previous_,           dt_previous_,
+          has_previous_, conductivity_,   balance_, last_inflow_pressure_, last_inflow_flux_};
+}
+
+void Solver::restore_state(const State& s) {
+  time_ = s.time;
+  steps_ = s.steps;
+  u_ = s.u;
+  u_previous_ = s.u_previous;
+  dt_previous_ = s.dt_previous;
+  has_previous_ = s.has_previous;
+  balance_ = s.balance;
+  last_inflow_pressure_ = s.last_inflow_pressure;
+  last_inflow_flux_ = s.last_inflow_flux;
+  if (s.conductivity != conductivity_) {
+    conductivity_ = s.conductivity;
+    assemble_conductivity();
+  }
+}
+
+}  // namespace outburst::seepage

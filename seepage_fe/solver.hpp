@@ -1,0 +1,177 @@
+#pragma once
+// The implicit seepage solver: Q1 finite elements in space, backward Euler or
+// variable-step BDF2 in time, Newton (with a line search) or Picard for the
+// nonlinear storage, CHOLMOD for the linear systems with the symbolic
+// factorisation computed once.
+//
+// Public face, in the order a driver uses it:
+//   Solver s(mesh, model, settings);
+//   s.set_conductivity(per_cell);   // optional: the coupler's lambda per cell
+//   s.advance(dt);                  // one step, cut and retried if it fails
+//   s.pressure_at(x), s.pressure_gradient_at(x)
+//   auto st = s.save_state(); ...; s.restore_state(st);   // coupling sub-iterations
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/CholmodSupport>
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+
+#include "seepage_fe/cell_locator.hpp"
+#include "seepage_fe/mesh.hpp"
+#include "seepage_fe/model.hpp"
+
+namespace outburst::seepage {
+
+// Volumetric source s(x, t) in stored units per volume per second (for the gas
+// law: standard gas volume per coal volume per second). Used by manufactured
+// solutions; a scene has none.
+using SourceFunction = std::function<double(const Eigen::Vector2d&, double)>;
+
+class StepFailure : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct StepReport {
+  int substeps = 0;           // accepted steps taken to cover the requested dt
+  int cuts = 0;               // failed attempts that were halved and retried
+  int nonlinear_iterations = 0;
+  double smallest_substep = 0;
+};
+
+// Gas (or fluid) balance since t = 0, per unit depth. Volumes are standard gas
+// volumes for the gas law and fluid volumes for the linear law [m^3/m].
+struct Balance {
+  double initial_stored = 0;
+  double stored = 0;
+  double inflow_through_flux = 0;  // flux boundaries and sources
+  std::vector<std::string> pressure_boundaries;
+  std::vector<double> inflow_through_pressure;  // per pressure boundary; < 0: outflow
+  // stored - initial - all inflow: zero up to the nonlinear solver tolerance.
+  double error() const;
+  double total_outflow() const;  // through pressure boundaries, > 0 when gas leaves
+};
+
+// Wall time spent in each part of the solver [s], for benchmarks and studies.
+struct Timings {
+  double assembly = 0;       // conductivity matrix
+  double residual = 0;       // residual evaluations, including line search trials
+  double jacobian = 0;       // building the Jacobian values
+  double factorization = 0;  // CHOLMOD numeric factorisation
+  double solve = 0;          // triangular solves
+  double total_step = 0;     // everything inside advance()
+  long factorizations = 0;
+  long nonlinear_iterations = 0;
+  long residual_evaluations = 0;
+};
+
+class Solver {
+ public:
+  Solver(Mesh mesh, Model model, Settings settings);
+  // The cell locator and the factorisation refer into the solver: it stays put.
+  Solver(const Solver&) = delete;
+  Solver& operator=(const Solver&) = delete;
+
+  // Advance by dt; a failing step is halved and retried up to max_step_cuts times,
+  // then StepFailure explains what failed and where.
+  StepReport advance(double dt);
+  double time() const { return time_; }
+  long steps() const { return steps_; }
+
+  // ---- what a coupling driver reads and writes
+  void set_conductivity(const std::vector<double>& per_cell);
+  const std::vector<double>& conductivity() const { return conductivity_; }
+  void set_source(SourceFunction source) { source_ = std::move(source); }
+  // Replace the initial nodal pressures p [Pa] (before the first step only).
+  void set_initial_pressure(const std::vector<double>& nodal_p);
+  // p [Pa] and grad p [Pa/m] at any point of the mesh; nullopt outside it.
+  std::optional<double> pressure_at(const Eigen::Vector2d& x) const;
+  std::optional<Eigen::Vector2d> pressure_gradient_at(const Eigen::Vector2d& x) const;
+
+  struct State {
+    double time;
+    long steps;
+    Eigen::VectorXd u, u_previous;
+    double dt_previous;
+    bool has_previous;
+    std::vector<double> conductivity;
+    Balance balance;
+    std::vector<double> last_inflow_pressure;  // BDF2 flux quadrature memory
+    double last_inflow_flux;
+  };
+  State save_state() const;
+  void restore_state(const State& state);
+
+  // ---- results
+  const Mesh& mesh() const { return mesh_; }
+  const Model& model() const { return model_; }
+  const Eigen::VectorXd& unknown() const { return u_; }  // P (gas) or p (linear)
+  std::vector<double> nodal_pressure() const;           // p [Pa]
+  std::vector<Eigen::Vector2d> cell_flux() const;       // -k grad u at cell centres [m/s]
+  const Balance& balance() const { return balance_; }
+  const Timings& timings() const { return timings_; }
+
+  // The current Jacobian (for benchmarks that time a bare factorisation of it).
+  const Eigen::SparseMatrix<double>& jacobian() const { return jacobian_; }
+
+ private:
+  void setup_system();
+  void assemble_conductivity();
+  void set_boundary_values(double t, Eigen::VectorXd& u) const;
+  void load_vector(double t, Eigen::VectorXd& f) const;
+  double residual(const Eigen::VectorXd& u, double a0, double h);
+  void build_jacobian(const Eigen::VectorXd& u, double a0, double h);
+  // One attempt at a step of size h; on failure returns the reason.
+  std::optional<std::string> try_step(double h, int& iterations);
+  void accept_step(double h, double a0, double a2);
+
+  Mesh mesh_;
+  Model model_;
+  Settings settings_;
+  CellLocator locator_;
+
+  // Geometry, computed once.
+  std::vector<Eigen::Matrix4d> cell_stiffness_;  // unit conductivity
+  Eigen::VectorXd capacity_;                     // sum over cells of c * int N_a
+  std::vector<std::array<int, 16>> scatter_;     // cell entry -> matrix value index
+  std::vector<int> diagonal_;                    // node -> value index of (i, i)
+
+  // Boundary conditions: per node, the condition index fixing it (or -1).
+  std::vector<int> fixed_by_;
+  std::vector<int> pressure_bc_slot_;  // condition index -> slot in balance vectors
+  std::vector<int> dirichlet_zero_;    // value indices zeroed in the Jacobian
+  std::vector<int> dirichlet_diagonal_;
+
+  std::vector<double> conductivity_;
+  long conductivity_version_ = 0;
+  Eigen::SparseMatrix<double> stiffness_;  // K = sum_e k_e K_e
+  Eigen::SparseMatrix<double> jacobian_;
+  Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::Lower> factor_;
+  struct FactorKey {
+    double h = -1, a0 = 0;
+    long version = -1;
+  } factor_key_;
+
+  SourceFunction source_;
+
+  // State.
+  double time_ = 0;
+  long steps_ = 0;
+  Eigen::VectorXd u_, u_previous_;
+  double dt_previous_ = 0;
+  bool has_previous_ = false;
+  Balance balance_;
+  std::vector<double> last_inflow_pressure_;
+  double last_inflow_flux_ = 0;
+
+  // Work vectors of the current step.
+  Eigen::VectorXd trial_, history_, load_, r_, delta_, candidate_;
+  double residual_scale_ = 0;
+  Timings timings_;
+};
+
+}  // namespace outburst::seepage

@@ -1,0 +1,126 @@
+// Bad input gets a clear error naming the file, the line, the key and what was
+// expected: a table of broken scenes, each with the message it must produce.
+#include <catch2/catch.hpp>
+
+#include "common/program.hpp"
+#include "seepage_fe/scene_reader.hpp"
+
+using namespace outburst;
+
+namespace {
+
+// What seepage-fe does with a scene before running it.
+void read_seepage_scene(const std::string& text, const std::vector<std::string>& overrides = {}) {
+  auto doc = scene::Document::parse(text, "broken.toml", overrides);
+  auto root = doc->root();
+  const auto header = read_scene_header(root);
+  require_solvers(root, header, {"seepage"}, "seepage-fe");
+  seepage::read_setup(*root.table("seepage", "", true));
+  doc->reject_unused();
+}
+
+const char* valid = R"toml([scene]
+solvers = ["seepage"]
+end_time = "1 d"
+[seepage]
+time_step = "1 h"
+[seepage.mesh]
+size = ["10 m", "1 m"]
+cells = [10, 1]
+[[seepage.regions]]
+name = "coal"
+lambda = "0.1 m2/(MPa2 d)"
+gas_content_coefficient = "2 MPa^-0.5"
+initial_pressure = "3 MPa"
+[[seepage.boundaries]]
+name = "left"
+type = "pressure"
+value = "0.1 MPa"
+)toml";
+
+std::string replace(std::string text, const std::string& from, const std::string& to) {
+  const auto at = text.find(from);
+  REQUIRE(at != std::string::npos);
+  return text.replace(at, from.size(), to);
+}
+
+}  // namespace
+
+TEST_CASE("the reference scene is valid", "[scene]") { REQUIRE_NOTHROW(read_seepage_scene(valid)); }
+
+TEST_CASE("broken scenes are rejected with file, line, key and what was expected", "[scene]") {
+  struct Row {
+    std::string scene;
+    std::vector<std::string> message_parts;
+  };
+  const std::vector<Row> rows = {
+      {replace(valid, "time_step = \"1 h\"", "time_stepp = \"1 h\""),
+       {"broken.toml", "seepage.time_step", "required key is missing"}},
+      {replace(valid, "[seepage]\n", "[seepage]\ncolour = \"red\"\n"),
+       {"broken.toml:5:10", "seepage.colour", "unknown key", "time_step"}},
+      {replace(valid, "end_time = \"1 d\"", "end_time = 86400"),
+       {"broken.toml:3:12", "scene.end_time", "expected a time with its unit", "bare number"}},
+      {replace(valid, "end_time = \"1 d\"", "end_time = \"1 m\""),
+       {"broken.toml:3:12", "scene.end_time", "expected a time", "which is a length"}},
+      {replace(valid, "initial_pressure = \"3 MPa\"", "initial_pressure = \"-3 MPa\""),
+       {"broken.toml:13:20", "seepage.regions[0].initial_pressure", "must be > 0"}},
+      {replace(valid, "lambda = \"0.1 m2/(MPa2 d)\"", "lambda = \"0.1 m2/(MPa d)\""),
+       {"seepage.regions[0].lambda", "expected a gas conductivity", "mobility"}},
+      {replace(valid, "cells = [10, 1]", "cells = [10, 0]"),
+       {"broken.toml:8:9", "seepage.mesh.cells", "must be >= 1"}},
+      {replace(valid, "cells = [10, 1]", "cells = [10]"),
+       {"seepage.mesh.cells", "expected an array of 2 integers"}},
+      {replace(valid, "type = \"pressure\"", "type = \"presure\""),
+       {"broken.toml:16:8", "seepage.boundaries[0].type", "expected one of \"pressure\", \"flux\""}},
+      {replace(valid, "name = \"left\"", "name = \"face\""),
+       {"seepage.boundaries[0].name", "no boundary \"face\"", "left, right, bottom, top"}},
+      {replace(valid, "solvers = [\"seepage\"]", "solvers = [\"seepage\", \"mpm\"]"),
+       {"broken.toml:2:11", "scene.solvers", "seepage-fe runs only seepage", "'mpm'"}},
+      {replace(valid, "solvers = [\"seepage\"]", "solvers = [\"seepage\", \"fluid\"]"),
+       {"scene.solvers", "\"fluid\" is not one of"}},
+      {replace(valid, "value = \"0.1 MPa\"", "value = [[\"0 s\", \"3 MPa\"], [\"0 s\", \"1 MPa\"]]"),
+       {"seepage.boundaries[0].value", "must increase strictly"}},
+      {replace(valid, "[seepage]\ntime_step", "[seepage]\nlaw = \"linear\"\ntime_step"),
+       {"seepage.regions[0].permeability", "required key is missing"}},
+      {replace(valid, "gas_content_coefficient = \"2 MPa^-0.5\"",
+               "gas_content_coefficient = \"1.25 m3/(t MPa^0.5)\""),
+       {"seepage.regions[0].coal_density", "required key is missing"}},
+      {replace(valid, "[[seepage.regions]]", "[[seepage.region]]"),
+       {"seepage.regions", "give at least one [[seepage.regions]]"}},
+      {replace(valid, "[scene]", "[scene\n"), {"broken.toml:1:", "not valid TOML"}},
+      {replace(valid, "[seepage.mesh]\n", "[seepage.mesh]\ntype = \"gmsh\"\nfile = \"nowhere.msh\"\n"),
+       {"seepage.mesh.file", "does not exist"}},
+  };
+  for (const auto& row : rows) {
+    INFO(row.scene);
+    try {
+      read_seepage_scene(row.scene);
+      FAIL("the broken scene was accepted");
+    } catch (const scene::Error& e) {
+      const std::string message = e.what();
+      INFO(message);
+      for (const auto& part : row.message_parts) CHECK_THAT(message, Catch::Contains(part));
+    }
+  }
+}
+
+TEST_CASE("command-line overrides replace scene keys and are checked like them", "[scene]") {
+  REQUIRE_NOTHROW(read_seepage_scene(valid, {"seepage.time_scheme=\"backward_euler\""}));
+  CHECK_THROWS_WITH(read_seepage_scene(valid, {"seepage.time_scheme=\"rk4\""}),
+                    Catch::Contains("--set: key 'seepage.time_scheme': expected one of"));
+  CHECK_THROWS_WITH(read_seepage_scene(valid, {"seepage.time_step=1 h"}),
+                    Catch::Contains("strings need quotes"));
+  CHECK_THROWS_WITH(read_seepage_scene(valid, {"seepage.timestep=\"1 h\""}),
+                    Catch::Contains("unknown key"));
+}
+
+TEST_CASE("explain lists every key read, marking defaults", "[scene]") {
+  auto doc = scene::Document::parse(valid, "valid.toml");
+  auto root = doc->root();
+  read_scene_header(root);
+  seepage::read_setup(*root.table("seepage", "", true));
+  const std::string text = doc->explain();
+  CHECK_THAT(text, Catch::Contains("seepage.time_scheme = \"bdf2\""));
+  CHECK_THAT(text, Catch::Contains("(default)"));
+  CHECK_THAT(text, Catch::Contains("seepage.regions[0].lambda = 0.1 m2/(MPa2 d)"));
+}

@@ -1,0 +1,132 @@
+#include <catch2/catch.hpp>
+
+#include <filesystem>
+#include <fstream>
+
+#include "seepage_fe/cell_locator.hpp"
+#include "seepage_fe/mesh.hpp"
+#include "seepage_fe/q1.hpp"
+
+using namespace outburst::seepage;
+namespace fs = std::filesystem;
+
+namespace {
+
+const fs::path source_dir = OUTBURST_SOURCE_DIR;
+
+double total_area(const Mesh& m) {
+  double area = 0;
+  for (const auto& c : m.cells) {
+    const auto integrals = q1::integrals({m.nodes[c[0]], m.nodes[c[1]], m.nodes[c[2]], m.nodes[c[3]]});
+    area += integrals.lumped.sum();
+  }
+  return area;
+}
+
+fs::path write_temp(const std::string& name, const std::string& text) {
+  const fs::path p = fs::temp_directory_path() / ("outburst_test_" + name);
+  std::ofstream(p) << text;
+  return p;
+}
+
+}  // namespace
+
+TEST_CASE("a generated mesh is graded as asked and paints regions by box", "[seepage][mesh]") {
+  StructuredMeshSpec spec;
+  spec.size = {10, 2};
+  spec.cells = {20, 4};
+  spec.grading = {10, 1};
+  spec.regions = {{"all", true, {}, {}}, {"right", false, {6, -1}, {11, 3}}};
+  const Mesh m = make_structured_mesh(spec);
+  CHECK(m.num_nodes() == 21 * 5);
+  CHECK(total_area(m) == Approx(20.0).epsilon(1e-12));
+  const double first = m.nodes[1].x() - m.nodes[0].x();
+  const double last = m.nodes[20].x() - m.nodes[19].x();
+  CHECK(last / first == Approx(10.0).epsilon(1e-12));
+  for (std::size_t c = 0; c < m.num_cells(); ++c) {
+    const double xc = 0.25 * (m.nodes[m.cells[c][0]].x() + m.nodes[m.cells[c][2]].x() +
+                              m.nodes[m.cells[c][1]].x() + m.nodes[m.cells[c][3]].x());
+    CHECK(m.cell_region[c] == (xc > 6 ? 1 : 0));
+  }
+  REQUIRE(m.boundary("left"));
+  CHECK(m.boundary("left")->edges.size() == 4);
+  CHECK(m.boundary("top")->edges.size() == 20);
+}
+
+TEST_CASE("the Gmsh reader keeps quads, regions and boundaries", "[seepage][mesh]") {
+  const Mesh m = read_gmsh(source_dir / "cases/verification/two_layers.msh");
+  CHECK(m.region_names.size() == 2);
+  CHECK(m.region_index("soft") >= 0);
+  CHECK(m.region_index("hard") >= 0);
+  CHECK(total_area(m) == Approx(10.0).epsilon(1e-12));
+  REQUIRE(m.boundary("inlet"));
+  double inlet_length = 0;
+  for (const auto& e : m.boundary("inlet")->edges) inlet_length += (m.nodes[e[1]] - m.nodes[e[0]]).norm();
+  CHECK(inlet_length == Approx(1.0).epsilon(1e-12));
+  // Every cell of region "soft" lies left of the interface x = 4.
+  for (std::size_t c = 0; c < m.num_cells(); ++c)
+    for (int k = 0; k < 4; ++k)
+      if (m.cell_region[c] == m.region_index("soft")) CHECK(m.nodes[m.cells[c][k]].x() <= 4 + 1e-12);
+}
+
+TEST_CASE("broken meshes are rejected with the line and what was expected", "[seepage][mesh]") {
+  const std::string header = "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n";
+  const std::string entities =
+      "$PhysicalNames\n1\n2 1 \"coal\"\n$EndPhysicalNames\n"
+      "$Entities\n0 0 1 0\n1 0 0 0 1 1 0 1 1 0\n$EndEntities\n";
+  const std::string nodes =
+      "$Nodes\n1 4 1 4\n2 1 0 4\n1\n2\n3\n4\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n$EndNodes\n";
+  const std::string quad = "$Elements\n1 1 1 1\n2 1 3 1\n1 1 2 3 4\n$EndElements\n";
+  // The good file first, so the table below tests only what each row breaks.
+  REQUIRE(read_gmsh(write_temp("good.msh", header + entities + nodes + quad)).num_cells() == 1);
+
+  struct Row {
+    std::string name, text, message;
+  };
+  const std::vector<Row> rows = {
+      {"v22.msh", "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n", ":2: MSH format 2.2 is not supported"},
+      {"binary.msh", "$MeshFormat\n4.1 1 8\n$EndMeshFormat\n", "binary MSH is not supported"},
+      {"triangles.msh",
+       header + entities + nodes + "$Elements\n1 1 1 1\n2 1 2 1\n1 1 2 3\n$EndElements\n",
+       "holds 3-node triangles; the seepage solver needs 4-node quadrangles"},
+      {"no_group.msh",
+       header + "$Entities\n0 0 1 0\n1 0 0 0 1 1 0 0 0\n$EndEntities\n" + nodes + quad,
+       "belongs to no physical group"},
+      {"missing_node.msh",
+       header + entities + nodes + "$Elements\n1 1 1 1\n2 1 3 1\n1 1 2 3 9\n$EndElements\n",
+       "uses node 9, which $Nodes does not define"},
+      {"bad_number.msh", header + entities + "$Nodes\n1 4 1 4\n2 1 0 4\n1\n2\n3\n4\n0 0 0\n1 x 0\n",
+       ":20: expected y (a number), got 'x'"},
+      {"truncated.msh", header + entities + "$Nodes\n1 4 1 4\n2 1 0 4\n1\n2\n",
+       "the file ends early"},
+      {"not_msh.msh", "hello\n", "no $MeshFormat section"},
+      {"clockwise_bowtie.msh",
+       header + entities + nodes + "$Elements\n1 1 1 1\n2 1 3 1\n1 1 3 2 4\n$EndElements\n",
+       "is degenerate or not convex"},
+  };
+  for (const auto& row : rows) {
+    INFO(row.name);
+    CHECK_THROWS_WITH(read_gmsh(write_temp(row.name, row.text)), Catch::Contains(row.message));
+  }
+}
+
+TEST_CASE("points are located in their cell on generated and Gmsh meshes", "[seepage][mesh]") {
+  const Mesh m = read_gmsh(source_dir / "cases/verification/two_layers.msh");
+  const CellLocator locator(m);
+  // Every cell's centre is found in that cell, and maps back to itself.
+  for (std::size_t c = 0; c < m.num_cells(); ++c) {
+    const q1::Corners x{m.nodes[m.cells[c][0]], m.nodes[m.cells[c][1]], m.nodes[m.cells[c][2]],
+                        m.nodes[m.cells[c][3]]};
+    const Eigen::Vector2d centre = 0.25 * (x[0] + x[1] + x[2] + x[3]);
+    const auto hit = locator.locate(centre);
+    REQUIRE(hit);
+    const auto n = q1::shape(hit->reference.x(), hit->reference.y());
+    Eigen::Vector2d back = Eigen::Vector2d::Zero();
+    const auto& hc = m.cells[hit->cell];
+    for (int a = 0; a < 4; ++a) back += n[a] * m.nodes[hc[a]];
+    CHECK((back - centre).norm() < 1e-12);
+  }
+  CHECK_FALSE(locator.locate({-0.1, 0.5}));
+  CHECK_FALSE(locator.locate({5.0, 1.2}));
+  CHECK(locator.locate({10.0, 1.0}));  // a corner of the domain
+}

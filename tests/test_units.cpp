@@ -1,0 +1,60 @@
+#include <catch2/catch.hpp>
+
+#include "common/units.hpp"
+
+namespace u = outburst::units;
+using u::Dimension;
+using u::Quantity;
+using u::parse_quantity;
+
+TEST_CASE("quantities convert to SI and carry their dimension", "[units]") {
+  struct Row {
+    const char* text;
+    double si;
+    Dimension dimension;
+  };
+  const Row rows[] = {
+      {"3 MPa", 3e6, u::pressure},
+      {"1.5e6 Pa", 1.5e6, u::pressure},
+      {"2 h", 7200, u::time},
+      {"10 d", 864000, u::time},
+      {"30 deg", 0.52359877559829887, u::angle},
+      {"1600 kg/m3", 1600, u::density},
+      {"9.81 m/s2", 9.81, u::acceleration},
+      {"9.81 m/s^2", 9.81, u::acceleration},
+      {"1e-9 1/Pa", 1e-9, u::inverse_pressure},
+      {"0.1 m2/(MPa2 d)", 0.1 / (1e12 * 86400), u::gas_conductivity},
+      {"0.1 m^2/(MPa^2*d)", 0.1 / (1e12 * 86400), u::gas_conductivity},
+      {"2 MPa^-0.5", 2e-3, u::gas_content_per_volume},
+      {"1.25 m3/(t MPa^0.5)", 1.25e-3 / 1e3, u::gas_content_per_mass},
+      {"1e-3 Pa s", 1e-3, u::viscosity},
+      {"1e-3 Pa.s", 1e-3, u::viscosity},
+      {"0.5", 0.5, u::dimensionless},
+  };
+  for (const auto& row : rows) {
+    INFO(row.text);
+    const Quantity q = parse_quantity(row.text);
+    CHECK(q.si == Approx(row.si).epsilon(1e-12));
+    CHECK(q.dimension == row.dimension);
+  }
+}
+
+TEST_CASE("malformed quantities are rejected with the reason", "[units]") {
+  const std::pair<const char*, const char*> rows[] = {
+      {"MPa", "does not start with a number"},
+      {"3 Mpa", "unknown unit 'Mpa'"},
+      {"3 m/(s", "missing ')'"},
+      {"3 m^", "expected an exponent"},
+      {"3 m #", "unexpected '#'"},
+  };
+  for (const auto& [text, message] : rows) {
+    INFO(text);
+    CHECK_THROWS_WITH(parse_quantity(text), Catch::Contains(message));
+  }
+}
+
+TEST_CASE("dimensions are named in messages", "[units]") {
+  CHECK(u::describe(u::pressure) == "pressure");
+  CHECK(u::describe(u::time) == "time");
+  CHECK(u::describe(Dimension{2, 0, -3, 0}) == "m^2 s^-3");
+}
