@@ -1,0 +1,105 @@
+// seepage-benchmark: where the time of a seepage step goes, beside a bare
+// CHOLMOD factor-and-solve of the same Jacobian in the same run.
+//
+// Problem (as the issue fixes it): unit square, A = 2, lambda = 0.1, P0 = 9
+// (p0 = 3), the left side drained to p = 1, backward Euler, Newton.
+// Usage: seepage-benchmark [cells per side ...]   (default 99 315 999: 1e4..1e6 unknowns)
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <vector>
+
+#include <omp.h>
+
+#include <Eigen/CholmodSupport>
+
+#include "common/blas.hpp"
+#include "seepage_fe/solver.hpp"
+
+using namespace outburst;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// Median-free and simple: the mean of `reps` factor-and-solve calls.
+double bare_factor_and_solve(const Eigen::SparseMatrix<double>& j, int mode, int reps) {
+  Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::Lower> f;
+  f.setMode(static_cast<Eigen::CholmodMode>(mode));
+  const Eigen::VectorXd b = Eigen::VectorXd::Ones(j.rows());
+  Eigen::VectorXd x;
+  if (mode == Eigen::CholmodSupernodalLLt) {  // as the solver configures it
+    f.cholmod().nmethods = 1;
+    f.cholmod().method[0].ordering = CHOLMOD_NESDIS;
+  }
+  f.analyzePattern(j);
+  omp_set_dynamic(1);
+  const auto start = Clock::now();
+  for (int r = 0; r < reps; ++r) {
+    f.factorize(j);
+    x = f.solve(b);
+  }
+  omp_set_dynamic(0);
+  if (f.info() != Eigen::Success) std::fprintf(stderr, "bare factorisation failed\n");
+  return seconds_since(start) / reps;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<int> sides;
+  for (int i = 1; i < argc; ++i) sides.push_back(std::atoi(argv[i]));
+  if (sides.empty()) sides = {99, 315, 999};
+  std::printf("BLAS: %s\n\n", blas::description().c_str());
+  std::printf("%9s %7s %9s %9s %9s %9s %9s %9s %7s %10s %10s %12s\n", "unknowns", "mode", "step[s]",
+              "newton[s]", "factor[s]", "solve[s]", "other[s]", "bare[s]", "other/", "assembly",
+              "assembly", "simplicial/");
+  std::printf("%9s %7s %9s %9s %9s %9s %9s %9s %7s %10s %10s %12s\n", "", "", "", "iteration",
+              "per it.", "per it.", "per it.", "fact+solve", "factor", "[s]", "[ns/cell]",
+              "supernodal");
+  for (int n : sides) {
+    seepage::StructuredMeshSpec spec;
+    spec.cells = {n, n};
+    spec.regions = {{"square", true, {}, {}}};
+    seepage::Model model;
+    model.law = seepage::Law::gas;
+    model.materials = {{0.1, 2.0, 3.0}};
+    model.boundary_conditions = {{"left", seepage::BoundaryCondition::Type::pressure, TimeFunction(1.0)}};
+    seepage::Settings settings;
+    settings.scheme = seepage::TimeScheme::backward_euler;
+    seepage::Solver solver(seepage::make_structured_mesh(spec), model, settings);
+    const long unknowns = static_cast<long>(solver.mesh().num_nodes());
+
+    const int steps = 2;
+    for (int s = 0; s < steps; ++s) solver.advance(1e-3);
+    const auto& t = solver.timings();
+    const double iterations = static_cast<double>(t.nonlinear_iterations);
+    const double factor = t.factorization / iterations;
+    const double solve = t.solve / iterations;
+    const double other = (t.total_step - t.factorization - t.solve) / iterations;
+
+    // Re-assembly of the conductivity matrix, as the coupler triggers it.
+    const auto start = Clock::now();
+    const int assemblies = 5;
+    for (int a = 0; a < assemblies; ++a) solver.set_conductivity(std::vector<double>(solver.mesh().num_cells(), 0.1 + 1e-3 * a));
+    const double assembly = seconds_since(start) / assemblies;
+
+    const bool supernodal = unknowns >= 100000;
+    const double bare = bare_factor_and_solve(solver.jacobian(), supernodal ? Eigen::CholmodSupernodalLLt
+                                                                            : Eigen::CholmodSimplicialLLt, 3);
+    // Both CHOLMOD modes on the same matrix, to place the switch between them.
+    const double simplicial = bare_factor_and_solve(solver.jacobian(), Eigen::CholmodSimplicialLLt, 2);
+    const double super = bare_factor_and_solve(solver.jacobian(), Eigen::CholmodSupernodalLLt, 2);
+    std::printf("%9ld %7s %9.4f %9.4f %9.4f %9.4f %9.4f %9.4f %7.3f %10.4f %10.1f %12.2f\n", unknowns,
+                supernodal ? "super" : "simpl", t.total_step / steps, t.total_step / iterations, factor, solve,
+                other, bare, other / factor, assembly, 1e9 * assembly / static_cast<double>(solver.mesh().num_cells()),
+                simplicial / super);
+    std::fflush(stdout);
+  }
+  std::printf("\nother = assembly, residuals, Jacobian values, line search and bookkeeping per Newton "
+              "iteration;\ngoal: other/factor <= 0.5 and assembly ns/cell flat across sizes.\n");
+  return 0;
+}
