@@ -72,17 +72,32 @@ void apply_override(toml::table& root, const std::string& assignment) {
                             "for example --set seepage.time_step='\"1 h\"'",
                             assignment, e.description()));
   }
+  // Walk the dotted path; "regions[1]" steps into an array of tables.
   toml::table* target = &root;
   std::string_view rest = path;
   for (;;) {
     const auto dot = rest.find('.');
-    const std::string key(rest.substr(0, dot));
-    if (dot == std::string_view::npos) {
+    std::string key(rest.substr(0, dot));
+    std::optional<std::size_t> index;
+    if (const auto open = key.find('['); open != std::string::npos && key.back() == ']') {
+      index = std::stoul(key.substr(open + 1, key.size() - open - 2));
+      key.resize(open);
+    }
+    if (dot == std::string_view::npos && !index) {
       parsed.get("v")->visit([&](auto& v) { target->insert_or_assign(key, v); });
       return;
     }
     toml::node* next = target->get(key);
-    if (!next) next = target->insert_or_assign(key, toml::table{}).first->second.as_table();
+    if (index) {
+      auto* arr = next ? next->as_array() : nullptr;
+      if (!arr || !arr->is_array_of_tables() || *index >= arr->size())
+        throw Error(fmt::format("--set '{}': the scene has no table {}[{}]", assignment, key, *index));
+      next = arr->get(*index);
+      if (dot == std::string_view::npos)
+        throw Error(fmt::format("--set '{}': name a key inside {}[{}]", assignment, key, *index));
+    } else if (!next) {
+      next = target->insert_or_assign(key, toml::table{}).first->second.as_table();
+    }
     if (!next->is_table())
       throw Error(fmt::format("--set '{}': '{}' is not a table", assignment, key));
     target = next->as_table();

@@ -5,8 +5,6 @@
 #include <cmath>
 #include <numeric>
 
-#include <omp.h>
-
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
@@ -307,12 +305,7 @@ std::optional<std::string> Solver::try_step(double h, int& iterations) {
       build_jacobian(trial_, a0, h);
       {
         ScopedTimer timer(timings_.factorization);
-        // Debian's CHOLMOD asks for 4 OpenMP threads whatever the machine; dynamic
-        // teams keep it to the cores there are (1.4x faster on 2 cores).
-        const int dynamic = omp_get_dynamic();
-        omp_set_dynamic(1);
         factor_.factorize(jacobian_);
-        omp_set_dynamic(dynamic);
         ++timings_.factorizations;
       }
       if (factor_.info() != Eigen::Success) {

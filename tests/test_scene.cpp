@@ -112,6 +112,12 @@ TEST_CASE("command-line overrides replace scene keys and are checked like them",
                     Catch::Contains("strings need quotes"));
   CHECK_THROWS_WITH(read_seepage_scene(valid, {"seepage.timestep=\"1 h\""}),
                     Catch::Contains("unknown key"));
+  // Keys inside arrays of tables are addressed by index.
+  REQUIRE_NOTHROW(read_seepage_scene(valid, {"seepage.regions[0].initial_pressure=\"5 MPa\""}));
+  CHECK_THROWS_WITH(read_seepage_scene(valid, {"seepage.regions[0].initial_pressure=\"-5 MPa\""}),
+                    Catch::Contains("--set: key 'seepage.regions[0].initial_pressure': must be > 0"));
+  CHECK_THROWS_WITH(read_seepage_scene(valid, {"seepage.regions[3].lambda=\"1 m2/(MPa2 d)\""}),
+                    Catch::Contains("no table regions[3]"));
 }
 
 TEST_CASE("explain lists every key read, marking defaults", "[scene]") {

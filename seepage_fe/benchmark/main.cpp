@@ -9,11 +9,10 @@
 #include <cstdlib>
 #include <vector>
 
-#include <omp.h>
-
 #include <Eigen/CholmodSupport>
 
 #include "common/blas.hpp"
+#include "common/program.hpp"
 #include "seepage_fe/solver.hpp"
 
 using namespace outburst;
@@ -36,13 +35,11 @@ double bare_factor_and_solve(const Eigen::SparseMatrix<double>& j, int mode, int
     f.cholmod().method[0].ordering = CHOLMOD_NESDIS;
   }
   f.analyzePattern(j);
-  omp_set_dynamic(1);
   const auto start = Clock::now();
   for (int r = 0; r < reps; ++r) {
     f.factorize(j);
     x = f.solve(b);
   }
-  omp_set_dynamic(0);
   if (f.info() != Eigen::Success) std::fprintf(stderr, "bare factorisation failed\n");
   return seconds_since(start) / reps;
 }
@@ -50,6 +47,7 @@ double bare_factor_and_solve(const Eigen::SparseMatrix<double>& j, int mode, int
 }  // namespace
 
 int main(int argc, char** argv) {
+  limit_openmp_threads_to_cores(argv);
   std::vector<int> sides;
   for (int i = 1; i < argc; ++i) sides.push_back(std::atoi(argv[i]));
   if (sides.empty()) sides = {99, 315, 999};

@@ -1,0 +1,95 @@
+#pragma once
+// Material points as a structure of arrays: each field is one contiguous
+// vector, so the kernels stream through memory and no particle owns heap data.
+
+#include <cstdint>
+#include <vector>
+
+#include "mpm_solid/grid.hpp"
+
+namespace outburst::mpm {
+
+template <int Dim>
+struct Particles {
+  std::vector<Vec<Dim>> x;                  // position [m]
+  std::vector<Vec<Dim>> v;                  // velocity [m/s]
+  std::vector<double> mass;                 // [kg per m of depth in 2D]
+  std::vector<double> volume;               // current [m^3 per m]
+  std::vector<double> volume0;              // initial
+  std::vector<double> half_width;           // initial half-width in cells (GIMP)
+  std::vector<Mat<Dim>> stress;             // Cauchy, tension positive [Pa]
+  std::vector<double> stress_zz;            // out-of-plane stress (plane strain)
+  std::vector<Mat<Dim>> velocity_gradient;  // L = grad v of the last step [1/s]
+  std::vector<Mat<Dim>> deformation;        // F
+  std::vector<Mat<Dim>> affine;             // APIC's B matrix
+  std::vector<Vec<Dim>> external_force;     // set by another program [N per m]
+  std::vector<std::int32_t> material;       // index into the scene's materials
+  std::vector<std::int32_t> id;             // stable identity (tracers, output)
+
+  std::size_t size() const { return x.size(); }
+
+  void add(const Vec<Dim>& position, const Vec<Dim>& velocity, double particle_mass,
+           double particle_volume, double half_width_cells, const Mat<Dim>& initial_stress,
+           double initial_stress_zz, int material_index) {
+    x.push_back(position);
+    v.push_back(velocity);
+    mass.push_back(particle_mass);
+    volume.push_back(particle_volume);
+    volume0.push_back(particle_volume);
+    half_width.push_back(half_width_cells);
+    stress.push_back(initial_stress);
+    stress_zz.push_back(initial_stress_zz);
+    velocity_gradient.push_back(Mat<Dim>::Zero());
+    deformation.push_back(Mat<Dim>::Identity());
+    affine.push_back(Mat<Dim>::Zero());
+    external_force.push_back(Vec<Dim>::Zero());
+    material.push_back(material_index);
+    id.push_back(static_cast<std::int32_t>(id.size()));
+  }
+
+  // Keep the particles whose flag is set, in order.
+  void keep(const std::vector<char>& flag) {
+    std::size_t to = 0;
+    for (std::size_t from = 0; from < size(); ++from) {
+      if (!flag[from]) continue;
+      if (to != from) {
+        x[to] = x[from];
+        v[to] = v[from];
+        mass[to] = mass[from];
+        volume[to] = volume[from];
+        volume0[to] = volume0[from];
+        half_width[to] = half_width[from];
+        stress[to] = stress[from];
+        stress_zz[to] = stress_zz[from];
+        velocity_gradient[to] = velocity_gradient[from];
+        deformation[to] = deformation[from];
+        affine[to] = affine[from];
+        external_force[to] = external_force[from];
+        material[to] = material[from];
+        id[to] = id[from];
+      }
+      ++to;
+    }
+    resize(to);
+  }
+
+ private:
+  void resize(std::size_t n) {
+    x.resize(n);
+    v.resize(n);
+    mass.resize(n);
+    volume.resize(n);
+    volume0.resize(n);
+    half_width.resize(n);
+    stress.resize(n);
+    stress_zz.resize(n);
+    velocity_gradient.resize(n);
+    deformation.resize(n);
+    affine.resize(n);
+    external_force.resize(n);
+    material.resize(n);
+    id.resize(n);
+  }
+};
+
+}  // namespace outburst::mpm

@@ -1,0 +1,77 @@
+#pragma once
+// Shape functions of the background grid, one dimension at a time (2D and 3D
+// weights are tensor products). Each is a policy the kernels are compiled for,
+// so the choice costs nothing per particle:
+//
+//   Linear  - tent functions, 2 nodes per direction; cell-crossing noise.
+//   Gimp    - uniform GIMP (Bardenhagen & Kober 2004): the tent convolved with
+//             the particle's characteristic function of half-width lp.
+//   Bspline - quadratic B-splines, 3 nodes per direction, C1 gradients.
+//
+// eval() takes the particle's grid coordinate xi (in cells from node 0) and the
+// particle half-width lp in cells, and fills `support` weights and their
+// derivatives d/dxi (divide by h for d/dx) for nodes base, base+1, ...
+
+#include <cmath>
+
+namespace outburst::mpm {
+
+struct Linear {
+  static constexpr int support = 2;
+  static constexpr const char* name = "linear";
+  static inline int eval(double xi, double /*lp*/, double* w, double* dw) {
+    const int base = static_cast<int>(std::floor(xi));
+    const double f = xi - base;
+    w[0] = 1 - f;
+    w[1] = f;
+    dw[0] = -1;
+    dw[1] = 1;
+    return base;
+  }
+};
+
+struct Gimp {
+  static constexpr int support = 3;
+  static constexpr const char* name = "gimp";
+  static inline int eval(double xi, double lp, double* w, double* dw) {
+    const int base = static_cast<int>(std::floor(xi - 1 - lp)) + 1;
+    for (int k = 0; k < 3; ++k) {
+      const double r = xi - (base + k);
+      const double a = std::abs(r);
+      const double s = r < 0 ? -1.0 : 1.0;
+      if (a < lp) {
+        w[k] = 1 - (r * r + lp * lp) / (2 * lp);
+        dw[k] = -r / lp;
+      } else if (a < 1 - lp) {
+        w[k] = 1 - a;
+        dw[k] = -s;
+      } else if (a < 1 + lp) {
+        const double g = 1 + lp - a;
+        w[k] = g * g / (4 * lp);
+        dw[k] = -s * g / (2 * lp);
+      } else {
+        w[k] = 0;
+        dw[k] = 0;
+      }
+    }
+    return base;
+  }
+};
+
+struct Bspline {
+  static constexpr int support = 3;
+  static constexpr const char* name = "bspline";
+  static inline int eval(double xi, double /*lp*/, double* w, double* dw) {
+    const int base = static_cast<int>(std::floor(xi - 0.5));
+    const double f = xi - base;  // in [0.5, 1.5)
+    w[0] = 0.5 * (1.5 - f) * (1.5 - f);
+    w[1] = 0.75 - (f - 1) * (f - 1);
+    w[2] = 0.5 * (f - 0.5) * (f - 0.5);
+    dw[0] = f - 1.5;
+    dw[1] = -2 * (f - 1);
+    dw[2] = f - 0.5;
+    return base;
+  }
+};
+
+}  // namespace outburst::mpm

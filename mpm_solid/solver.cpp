@@ -1,0 +1,328 @@
+#include "mpm_solid/solver.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "mpm_solid/shape.hpp"
+#include "mpm_solid/stencil.hpp"
+
+namespace outburst::mpm {
+
+namespace {
+
+template <class Shape>
+using Stencil2 = Stencil<2, Shape>;
+
+// Adds each thread's private copy into the first and clears the others.
+void reduce(std::vector<std::vector<double>>& parts, std::vector<double>& total) {
+  const std::size_t n = total.size();
+#pragma omp parallel for schedule(static)
+  for (std::size_t i = 0; i < n; ++i) {
+    double sum = 0;
+    for (auto& part : parts) {
+      sum += part[i];
+      part[i] = 0;
+    }
+    total[i] = sum;
+  }
+}
+
+void reduce(std::vector<std::vector<Vec<2>>>& parts, std::vector<Vec<2>>& total) {
+  const std::size_t n = total.size();
+#pragma omp parallel for schedule(static)
+  for (std::size_t i = 0; i < n; ++i) {
+    Vec<2> sum = Vec<2>::Zero();
+    for (auto& part : parts) {
+      sum += part[i];
+      part[i].setZero();
+    }
+    total[i] = sum;
+  }
+}
+
+}  // namespace
+
+Solver::Solver(Grid<2> grid, std::vector<std::unique_ptr<Material>> materials,
+               Particles<2> particles, Settings settings)
+    : grid_(grid),
+      materials_(std::move(materials)),
+      particles_(std::move(particles)),
+      settings_(settings) {
+  if (particles_.size() == 0) throw std::invalid_argument("the scene creates no particles");
+  const std::size_t n = grid_.num_nodes();
+  mass_.assign(n, 0.0);
+  for (auto* v : {&momentum_, &force_, &velocity_, &velocity_new_}) v->assign(n, Vec<2>::Zero());
+  const int threads = omp_get_max_threads();
+  thread_mass_.assign(static_cast<std::size_t>(threads), std::vector<double>(n, 0.0));
+  thread_vector_.assign(static_cast<std::size_t>(threads), std::vector<Vec<2>>(n, Vec<2>::Zero()));
+  node_ij_.resize(n);
+  for (int j = 0; j < grid_.nodes_along(1); ++j)
+    for (int i = 0; i < grid_.nodes_along(0); ++i) node_ij_[grid_.index({i, j})] = {i, j};
+
+  double total_mass = 0;
+  for (double m : particles_.mass) total_mass += m;
+  empty_node_mass_ = settings_.empty_node_mass_fraction * total_mass / static_cast<double>(particles_.size());
+  rebuild_material_groups();
+
+  // One kernel per (shape, scheme), chosen here once.
+  const auto pick = [&]<class Shape>() -> void (Solver::*)(double) {
+    switch (settings_.scheme) {
+      case Scheme::usf: return &Solver::step_kernel<Shape, Scheme::usf>;
+      case Scheme::usl: return &Solver::step_kernel<Shape, Scheme::usl>;
+      case Scheme::musl: return &Solver::step_kernel<Shape, Scheme::musl>;
+    }
+    return nullptr;
+  };
+  switch (settings_.shape) {
+    case ShapeKind::linear: kernel_ = pick.template operator()<Linear>(); break;
+    case ShapeKind::gimp: kernel_ = pick.template operator()<Gimp>(); break;
+    case ShapeKind::bspline: kernel_ = pick.template operator()<Bspline>(); break;
+  }
+}
+
+void Solver::rebuild_material_groups() {
+  members_.assign(materials_.size(), {});
+  for (std::size_t p = 0; p < particles_.size(); ++p) members_[particles_.material[p]].push_back(static_cast<int>(p));
+}
+
+double Solver::stable_time_step() const {
+  double fastest = 0;
+  for (std::size_t p = 0; p < particles_.size(); ++p) {
+    const auto& e = materials_[particles_.material[p]]->elasticity();
+    // The wave speed grows as the material compresses (density rises).
+    const double density = particles_.mass[p] / particles_.volume[p];
+    const double c = std::sqrt((e.lame_lambda() + 2 * e.shear_modulus()) / density);
+    fastest = std::max(fastest, c + particles_.v[p].norm());
+  }
+  return settings_.courant * grid_.h / fastest;
+}
+
+template <class Shape>
+void Solver::scatter_mass_momentum() {
+  const auto& p = particles_;
+  const int n = static_cast<int>(p.size());
+#pragma omp parallel
+  {
+    auto& m = thread_mass_[omp_get_thread_num()];
+    auto& mv = thread_vector_[omp_get_thread_num()];
+    Stencil2<Shape> s;
+#pragma omp for schedule(static)
+    for (int i = 0; i < n; ++i) {
+      s.compute(grid_, p.x[i], p.half_width[i]);
+      for (int k = 0; k < s.count; ++k) {
+        const double wm = s.weight[k] * p.mass[i];
+        m[s.node[k]] += wm;
+        mv[s.node[k]] += wm * p.v[i];
+      }
+    }
+  }
+  reduce(thread_mass_, mass_);
+  reduce(thread_vector_, momentum_);
+}
+
+void Solver::grid_velocities() {
+  const std::size_t n = mass_.size();
+#pragma omp parallel for schedule(static)
+  for (std::size_t i = 0; i < n; ++i)
+    velocity_[i] = mass_[i] > empty_node_mass_ ? Vec<2>(momentum_[i] / mass_[i]) : Vec<2>::Zero();
+  apply_walls(velocity_);
+}
+
+template <class Shape>
+void Solver::gather_velocity_gradient() {
+  auto& p = particles_;
+  const int n = static_cast<int>(p.size());
+#pragma omp parallel
+  {
+    Stencil2<Shape> s;
+#pragma omp for schedule(static)
+    for (int i = 0; i < n; ++i) {
+      s.compute(grid_, p.x[i], p.half_width[i]);
+      Mat<2> l = Mat<2>::Zero();
+      for (int k = 0; k < s.count; ++k) l += velocity_[s.node[k]] * s.gradient[k].transpose();
+      p.velocity_gradient[i] = l;
+    }
+  }
+}
+
+void Solver::update_stresses(double dt) {
+  for (std::size_t m = 0; m < materials_.size(); ++m) materials_[m]->update_stress(particles_, members_[m], dt);
+  auto& p = particles_;
+  const int n = static_cast<int>(p.size());
+#pragma omp parallel for schedule(static)
+  for (int i = 0; i < n; ++i) {
+    p.deformation[i] = (Mat<2>::Identity() + dt * p.velocity_gradient[i]) * p.deformation[i];
+    p.volume[i] = p.volume0[i] * p.deformation[i].determinant();
+  }
+}
+
+template <class Shape>
+void Solver::scatter_forces() {
+  const auto& p = particles_;
+  const int n = static_cast<int>(p.size());
+  const Vec<2> g = settings_.gravity;
+#pragma omp parallel
+  {
+    auto& f = thread_vector_[omp_get_thread_num()];
+    Stencil2<Shape> s;
+#pragma omp for schedule(static)
+    for (int i = 0; i < n; ++i) {
+      s.compute(grid_, p.x[i], p.half_width[i]);
+      const Mat<2> vs = p.volume[i] * p.stress[i];
+      const Vec<2> body = p.mass[i] * g + p.external_force[i];
+      for (int k = 0; k < s.count; ++k) f[s.node[k]] += s.weight[k] * body - vs * s.gradient[k];
+    }
+  }
+  reduce(thread_vector_, force_);
+}
+
+void Solver::grid_update(double dt) {
+  const std::size_t n = mass_.size();
+#pragma omp parallel for schedule(static)
+  for (std::size_t i = 0; i < n; ++i)
+    velocity_new_[i] = mass_[i] > empty_node_mass_ ? Vec<2>(velocity_[i] + dt * force_[i] / mass_[i])
+                                                   : Vec<2>::Zero();
+  apply_walls(velocity_new_);
+}
+
+// Walls sit on the physical domain's edges; nodes on or beyond an edge take its
+// condition. Friction walls act only on nodes moving into them: the normal
+// velocity is removed and the tangential one reduced by mu times that change.
+void Solver::apply_walls(std::vector<Vec<2>>& velocity) const {
+  const int g = Grid<2>::ghost;
+  const int last[2] = {g + grid_.cells[0], g + grid_.cells[1]};
+  const std::size_t n = velocity.size();
+#pragma omp parallel for schedule(static)
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto& ij = node_ij_[i];
+    for (int side = 0; side < 4; ++side) {
+      const Wall& wall = settings_.walls[side];
+      if (wall.type == Wall::Type::open) continue;
+      const int axis = side / 2;
+      const bool low = side % 2 == 0;
+      if (low ? ij[axis] > g : ij[axis] < last[axis]) continue;
+      Vec<2>& v = velocity[i];
+      const double outward = low ? -1.0 : 1.0;  // wall normal pointing out of the domain
+      switch (wall.type) {
+        case Wall::Type::fixed: v.setZero(); break;
+        case Wall::Type::roller: v[axis] = 0; break;
+        case Wall::Type::friction: {
+          const double vn = v[axis] * outward;
+          if (vn <= 0) break;  // separating
+          v[axis] = 0;
+          const int t = 1 - axis;
+          const double reduced = std::max(std::abs(v[t]) - wall.friction * vn, 0.0);
+          v[t] = std::copysign(reduced, v[t]);
+          break;
+        }
+        case Wall::Type::open: break;
+      }
+    }
+  }
+}
+
+template <class Shape>
+void Solver::gather_motion(double dt) {
+  auto& p = particles_;
+  const int n = static_cast<int>(p.size());
+  const double flip = settings_.flip_fraction;
+#pragma omp parallel
+  {
+    Stencil2<Shape> s;
+#pragma omp for schedule(static)
+    for (int i = 0; i < n; ++i) {
+      s.compute(grid_, p.x[i], p.half_width[i]);
+      Vec<2> v_pic = Vec<2>::Zero(), dv = Vec<2>::Zero();
+      for (int k = 0; k < s.count; ++k) {
+        const auto node = s.node[k];
+        v_pic += s.weight[k] * velocity_new_[node];
+        dv += s.weight[k] * (velocity_new_[node] - velocity_[node]);
+      }
+      displacement_[i] = dt * v_pic;
+      p.v[i] = flip * (p.v[i] + dv) + (1 - flip) * v_pic;
+    }
+  }
+}
+
+// Every transfer of a step uses the particles' positions at its start; they move
+// at the end.
+template <class Shape, Scheme S>
+void Solver::step_kernel(double dt) {
+  displacement_.resize(particles_.size());
+  scatter_mass_momentum<Shape>();
+  grid_velocities();
+  if constexpr (S == Scheme::usf) {
+    gather_velocity_gradient<Shape>();
+    update_stresses(dt);
+  }
+  scatter_forces<Shape>();
+  grid_update(dt);
+  gather_motion<Shape>(dt);
+  if constexpr (S == Scheme::musl) {
+    // Map the updated particle momentum back and take the velocity gradient of
+    // that field: empty-ish nodes no longer carry the grid update's noise.
+    scatter_mass_momentum<Shape>();
+    grid_velocities();
+  }
+  if constexpr (S != Scheme::usf) {
+    if constexpr (S == Scheme::usl) velocity_.swap(velocity_new_);
+    gather_velocity_gradient<Shape>();
+    update_stresses(dt);
+  }
+  for (std::size_t i = 0; i < particles_.size(); ++i) particles_.x[i] += displacement_[i];
+}
+
+void Solver::remove_escaped(StepInfo& info) {
+  auto& p = particles_;
+  std::vector<char> keep(p.size(), 1);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (!p.x[i].allFinite() || !p.v[i].allFinite() || !p.stress[i].allFinite()) {
+      const char* field = !p.x[i].allFinite() ? "position" : !p.v[i].allFinite() ? "velocity" : "stress";
+      throw SimulationError(fmt::format(
+          "mpm: step {} (t = {:.6g} s): particle {} (material \"{}\") has a non-finite {}; the time "
+          "step may exceed the stable one, or a material parameter is out of range",
+          steps_ + 1, time_, p.id[i], materials_[p.material[i]]->name(), field));
+    }
+    if (!grid_.inside(p.x[i])) {
+      keep[i] = 0;
+      ++info.removed;
+    }
+  }
+  if (info.removed > 0) {
+    if (info.removed == p.size())
+      throw SimulationError(fmt::format("mpm: step {}: every particle has left the grid", steps_ + 1));
+    p.keep(keep);
+    removed_ += info.removed;
+    rebuild_material_groups();
+  }
+}
+
+StepInfo Solver::step(double dt) {
+  StepInfo info{dt};
+  (this->*kernel_)(dt);
+  remove_escaped(info);
+  time_ += dt;
+  ++steps_;
+  return info;
+}
+
+void Solver::restore_state(const State& s) {
+  time_ = s.time;
+  steps_ = s.steps;
+  removed_ = s.removed;
+  const bool same_particles = s.particles.size() == particles_.size();
+  particles_ = s.particles;
+  if (!same_particles) rebuild_material_groups();
+}
+
+double Solver::kinetic_energy() const {
+  double e = 0;
+  for (std::size_t i = 0; i < particles_.size(); ++i) e += 0.5 * particles_.mass[i] * particles_.v[i].squaredNorm();
+  return e;
+}
+
+}  // namespace outburst::mpm
