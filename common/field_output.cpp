@@ -159,7 +159,7 @@ void FieldSeries::write_index() const {
         const std::size_t rows = f.center == Center::node ? nodes : cells;
         x += fmt::format(
             "<Attribute Name=\"{}\" AttributeType=\"{}\" Center=\"{}\">\n{}\n</Attribute>\n",
-            xml_escape(f.name), f.components == 1 ? "Scalar" : "Vector",
+            xml_escape(f.name), f.components == 1 ? "Scalar" : f.components == 6 ? "Tensor6" : "Vector",
             f.center == Center::node ? "Node" : "Cell",
             data_item(snap.file, "/" + grid + "/" + f.name, rows, f.components, false));
       }

@@ -32,7 +32,9 @@ enum class Center { node, cell };
 struct Field {
   std::string name;
   Center center;
-  int components;  // 1 scalar, 3 vector (2D vectors are padded with z = 0)
+  // 1 scalar, 3 vector (2D vectors are padded with z = 0), 6 symmetric tensor
+  // in XDMF's Tensor6 order xx, xy, xz, yy, yz, zz
+  int components;
   std::string unit;
   std::vector<double> values;  // entity-major: values[i * components + c]
 };

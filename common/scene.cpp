@@ -341,6 +341,27 @@ std::vector<double> Table::quantity_vector(const Key& key, const units::Dimensio
   return values;
 }
 
+std::vector<std::array<double, 2>> Table::quantity_points(const Key& key,
+                                                         const units::Dimension& dimension) const {
+  const toml::node* n = required_node(key);
+  const std::string form = fmt::format("expected an array of points [[\"x\", \"y\"], ...], each coordinate a {} "
+                                       "with its unit",
+                                       units::describe(dimension));
+  const auto* arr = n ? n->as_array() : nullptr;
+  if (!arr) fail(key.name, form);
+  std::vector<std::array<double, 2>> points;
+  for (const auto& item : *arr) {
+    const auto* pair = item.as_array();
+    if (!pair || pair->size() != 2 || !pair->get(0)->is_string() || !pair->get(1)->is_string())
+      fail(key.name, form);
+    const auto fail_here = [&](const std::string& m) { fail(key.name, m); };
+    points.push_back({quantity_from_text(pair->get(0)->as_string()->get(), dimension, fail_here).si,
+                      quantity_from_text(pair->get(1)->as_string()->get(), dimension, fail_here).si});
+  }
+  record(key, node_text(*n), false);
+  return points;
+}
+
 double Table::number(const Key& key) const {
   const toml::node* n = required_node(key);
   double v = 0;

@@ -8,6 +8,7 @@
 // does not run) are reported at the end of parsing instead of being ignored.
 // Errors name the file, line, column and dotted key path, and what was expected.
 
+#include <array>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -84,6 +85,8 @@ class Table {
                                                   const units::Dimension& b) const;
   std::vector<double> quantity_vector(const Key& key, const units::Dimension& dimension,
                                       std::size_t count) const;
+  // An array of points, each a pair of quantities: [["0 m", "1 m"], ...].
+  std::vector<std::array<double, 2>> quantity_points(const Key& key, const units::Dimension& dimension) const;
   double number(const Key& key) const;
   long integer(const Key& key) const;
   std::vector<long> integer_vector(const Key& key, std::size_t count) const;

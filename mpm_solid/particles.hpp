@@ -12,6 +12,7 @@ namespace outburst::mpm {
 template <int Dim>
 struct Particles {
   std::vector<Vec<Dim>> x;                  // position [m]
+  std::vector<Vec<Dim>> x0;                 // initial position [m]
   std::vector<Vec<Dim>> v;                  // velocity [m/s]
   std::vector<double> mass;                 // [kg per m of depth in 2D]
   std::vector<double> volume;               // current [m^3 per m]
@@ -32,6 +33,7 @@ struct Particles {
            double particle_volume, double half_width_cells, const Mat<Dim>& initial_stress,
            double initial_stress_zz, int material_index) {
     x.push_back(position);
+    x0.push_back(position);
     v.push_back(velocity);
     mass.push_back(particle_mass);
     volume.push_back(particle_volume);
@@ -54,6 +56,7 @@ struct Particles {
       if (!flag[from]) continue;
       if (to != from) {
         x[to] = x[from];
+        x0[to] = x0[from];
         v[to] = v[from];
         mass[to] = mass[from];
         volume[to] = volume[from];
@@ -76,6 +79,7 @@ struct Particles {
  private:
   void resize(std::size_t n) {
     x.resize(n);
+    x0.resize(n);
     v.resize(n);
     mass.resize(n);
     volume.resize(n);

@@ -182,6 +182,12 @@ void Solver::scatter_forces() {
 
 void Solver::grid_update(double dt) {
   const std::size_t n = mass_.size();
+  if (const double alpha = settings_.local_damping; alpha > 0) {
+#pragma omp parallel for schedule(static)
+    for (std::size_t i = 0; i < n; ++i)
+      for (int d = 0; d < 2; ++d)
+        if (velocity_[i][d] != 0) force_[i][d] -= alpha * std::abs(force_[i][d]) * std::copysign(1.0, velocity_[i][d]);
+  }
 #pragma omp parallel for schedule(static)
   for (std::size_t i = 0; i < n; ++i)
     velocity_new_[i] = mass_[i] > empty_node_mass_ ? Vec<2>(velocity_[i] + dt * force_[i] / mass_[i])
@@ -189,37 +195,51 @@ void Solver::grid_update(double dt) {
   apply_walls(velocity_new_);
 }
 
-// Walls sit on the physical domain's edges; nodes on or beyond an edge take its
-// condition. Friction walls act only on nodes moving into them: the normal
-// velocity is removed and the tangential one reduced by mu times that change.
+// Walls sit on the physical domain's edges, on a row of nodes. The wall node
+// takes the condition; ghost nodes beyond it mirror the node inside, with the
+// constrained components reflected oddly, so the interpolated velocity meets the
+// condition at the wall itself and not half a cell inside (which costs wide
+// shape functions a whole order of accuracy). Friction walls act only on nodes
+// moving into them: the normal velocity is removed and the tangential one
+// reduced by mu times that change.
 void Solver::apply_walls(std::vector<Vec<2>>& velocity) const {
   const int g = Grid<2>::ghost;
-  const int last[2] = {g + grid_.cells[0], g + grid_.cells[1]};
   const std::size_t n = velocity.size();
-#pragma omp parallel for schedule(static)
-  for (std::size_t i = 0; i < n; ++i) {
-    const auto& ij = node_ij_[i];
+  // Wall rows first, then ghost rows outward, so that every mirror is final
+  // when it is read (thin domains mirror one wall's ghosts in the other's).
+  for (int depth = 0; depth <= g; ++depth) {
     for (int side = 0; side < 4; ++side) {
       const Wall& wall = settings_.walls[side];
       if (wall.type == Wall::Type::open) continue;
-      const int axis = side / 2;
-      const bool low = side % 2 == 0;
-      if (low ? ij[axis] > g : ij[axis] < last[axis]) continue;
-      Vec<2>& v = velocity[i];
-      const double outward = low ? -1.0 : 1.0;  // wall normal pointing out of the domain
-      switch (wall.type) {
-        case Wall::Type::fixed: v.setZero(); break;
-        case Wall::Type::roller: v[axis] = 0; break;
-        case Wall::Type::friction: {
-          const double vn = v[axis] * outward;
-          if (vn <= 0) break;  // separating
-          v[axis] = 0;
-          const int t = 1 - axis;
-          const double reduced = std::max(std::abs(v[t]) - wall.friction * vn, 0.0);
-          v[t] = std::copysign(reduced, v[t]);
-          break;
+      const int axis = side / 2, t = 1 - axis;
+      const int outward = side % 2 == 0 ? -1 : 1;  // wall normal, out of the domain
+      const int wall_row = outward < 0 ? g : g + grid_.cells[axis];
+#pragma omp parallel for schedule(static)
+      for (std::size_t i = 0; i < n; ++i) {
+        const auto& ij = node_ij_[i];
+        if ((ij[axis] - wall_row) * outward != depth) continue;
+        Vec<2>& v = velocity[i];
+        if (depth > 0 && wall.type != Wall::Type::friction) {
+          auto mirror = ij;
+          mirror[axis] = wall_row - depth * outward;
+          const Vec<2>& m = velocity[grid_.index(mirror)];
+          v[axis] = -m[axis];
+          v[t] = wall.type == Wall::Type::fixed ? -m[t] : m[t];
+          continue;
         }
-        case Wall::Type::open: break;
+        switch (wall.type) {
+          case Wall::Type::fixed: v.setZero(); break;
+          case Wall::Type::roller: v[axis] = 0; break;
+          case Wall::Type::friction: {
+            const double vn = v[axis] * outward;
+            if (vn <= 0) break;  // separating
+            v[axis] = 0;
+            const double reduced = std::max(std::abs(v[t]) - wall.friction * vn, 0.0);
+            v[t] = std::copysign(reduced, v[t]);
+            break;
+          }
+          case Wall::Type::open: break;
+        }
       }
     }
   }

@@ -40,6 +40,9 @@ struct Settings {
   double flip_fraction = 0.99;  // 1: pure FLIP, 0: pure PIC
   double courant = 0.3;
   Vec<2> gravity = Vec<2>::Zero();
+  // Local (Cundall) damping coefficient for quasi-static stages: each nodal
+  // force component loses alpha |f| against the node's motion. 0: off.
+  double local_damping = 0;
   // left, right, bottom, top of the physical domain
   std::array<Wall, 4> walls;
   // Nodes lighter than this fraction of the mean particle mass are treated as
@@ -73,6 +76,8 @@ class Solver {
   std::size_t removed_particles() const { return removed_; }
   const Grid<2>& grid() const { return grid_; }
   const Settings& settings() const { return settings_; }
+  // Switch local damping on (quasi-static stage) or off (dynamic stage).
+  void set_local_damping(double alpha) { settings_.local_damping = alpha; }
   const std::vector<std::unique_ptr<Material>>& materials() const { return materials_; }
 
   // Read access, and the per-particle external force another program sets.

@@ -1,7 +1,8 @@
-"""ParaView opens what seepage-fe writes: run a scene, read its XDMF with
-ParaView's own reader (by absolute path), and check times, mesh and fields.
+"""ParaView opens what a program writes: run a scene, read its XDMF with
+ParaView's own reader (by absolute path), and check times, topology and fields.
 
-usage: pvpython paraview_opens.py SEEPAGE_FE SCENE WORKDIR
+usage: pvpython paraview_opens.py PROGRAM SCENE WORKDIR XDMF_NAME FIELDS [--set ...]...
+FIELDS is a comma-separated list of the point and cell arrays expected.
 """
 import os
 import subprocess
@@ -9,25 +10,23 @@ import sys
 
 from paraview.simple import XDMFReader, servermanager
 
-program, scene, workdir = sys.argv[1:4]
+program, scene, workdir, xdmf_name, fields = sys.argv[1:6]
 out = os.path.abspath(os.path.join(workdir, "out"))
-subprocess.run([program, scene, "--quiet", "-o", out,
-                "--set", 'scene.end_time="3 d"', "--set", 'output.interval="1 d"'],
-               check=True)
-reader = XDMFReader(FileNames=[os.path.join(out, "seepage.xdmf")])
+subprocess.run([program, scene, "--quiet", "-o", out] + sys.argv[6:], check=True)
+reader = XDMFReader(FileNames=[os.path.join(out, xdmf_name)])
 reader.UpdatePipelineInformation()
 times = list(reader.TimestepValues)
-assert times == [0.0, 86400.0, 172800.0, 259200.0], times
+assert len(times) >= 2 and times[0] == 0.0, times
 reader.UpdatePipeline(times[-1])
 data = servermanager.Fetch(reader)
 points = data.GetPointData()
 cells = data.GetCellData()
 names = sorted([points.GetArrayName(i) for i in range(points.GetNumberOfArrays())] +
                [cells.GetArrayName(i) for i in range(cells.GetNumberOfArrays())])
-assert names == ["P", "flux", "lambda", "p", "region"], names
-assert data.GetNumberOfCells() > 0
-low, high = points.GetArray("p").GetRange()
-assert abs(low - 1e5) < 1 and 1e5 < high <= 3e6 * (1 + 1e-12), (low, high)
-assert cells.GetArray("flux").GetNumberOfComponents() == 3
+assert names == sorted(fields.split(",")), names
+assert data.GetNumberOfPoints() > 0 and data.GetNumberOfCells() > 0, "empty grid"
+for i in range(points.GetNumberOfArrays()):
+    low, high = points.GetArray(i).GetRange(-1)
+    assert low == low and high == high, f"NaN in {points.GetArrayName(i)}"
 print(f"ParaView read {len(times)} times, {data.GetNumberOfPoints()} points, "
-      f"{data.GetNumberOfCells()} cells, fields {names}, p in [{low:.4g}, {high:.4g}] Pa")
+      f"{data.GetNumberOfCells()} cells, fields {names}")

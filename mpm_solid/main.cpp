@@ -1,0 +1,70 @@
+// mpm-solid: the MPM solver for coal and rock on its own (dry scenes).
+#include <chrono>
+
+#include <spdlog/spdlog.h>
+
+#include "common/program.hpp"
+#include "common/progress.hpp"
+#include "mpm_solid/output.hpp"
+#include "mpm_solid/scene_reader.hpp"
+
+using namespace outburst;
+
+namespace {
+
+int run(const RunOptions& options, scene::Document& doc) {
+  auto root = doc.root();
+  const SceneHeader header = read_scene_header(root);
+  require_solvers(root, header, {"mpm"}, "mpm-solid");
+  mpm::Setup setup = mpm::read_setup(*root.table("mpm", "the material point solver", true));
+  if (!finish_reading(options, doc)) return 0;
+
+  mpm::Solver solver(setup.grid, std::move(setup.materials), std::move(setup.particles), setup.settings);
+  const double stable = solver.stable_time_step();
+  if (setup.fixed_time_step && *setup.fixed_time_step > stable / setup.settings.courant)
+    throw scene::Error(fmt::format(
+        "{}: key 'mpm.time_step': {:.3g} s exceeds the stability limit h / (c + |v|) = {:.3g} s of this scene; "
+        "use a smaller step or drop the key to let the CFL condition choose",
+        doc.file().string(), *setup.fixed_time_step, stable / setup.settings.courant));
+  spdlog::info("{}: {} particles, {} x {} cells of {:g} m, stable step {:.3g} s", header.title,
+               solver.particles().size(), setup.grid.cells[0], setup.grid.cells[1], setup.grid.h, stable);
+
+  const auto wall_start = std::chrono::steady_clock::now();
+  mpm::Output out(options.output_directory(), run_info("mpm-solid", doc, "SI: m, s, kg, Pa; 2D plane strain, "
+                                                                         "per metre of depth"));
+  out.snapshot(solver);
+  Progress progress("mpm", 0.0, header.end_time, options.show_progress());
+  double next_output = header.output_interval;
+  while (solver.time() < header.end_time * (1 - 1e-12)) {
+    const double target = std::min(next_output, header.end_time);
+    const double dt = std::min(setup.fixed_time_step ? *setup.fixed_time_step : solver.stable_time_step(),
+                               target - solver.time());
+    try {
+      const auto info = solver.step(dt);
+      out.history(solver, info);
+      if (info.removed > 0) spdlog::debug("{} particles left the grid at t = {:.6g} s", info.removed, solver.time());
+    } catch (const mpm::SimulationError&) {
+      out.snapshot(solver);  // the last state, for a look at what went wrong
+      throw;
+    }
+    progress.update(solver.steps(), solver.time(), dt, fmt::format("particles {}", solver.particles().size()));
+    if (solver.time() >= target * (1 - 1e-12)) {
+      out.snapshot(solver);
+      next_output += header.output_interval;
+    }
+  }
+  progress.finish();
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  spdlog::info("done: {} steps, {:.3g} s wall, {:.3g} particle-steps/s, {} particles left the grid",
+               solver.steps(), wall, static_cast<double>(solver.steps()) * static_cast<double>(solver.particles().size()) / wall,
+               solver.removed_particles());
+  spdlog::info("results: {}", std::filesystem::absolute(out.series().index_path()).string());
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return run_program("mpm-solid", "Coal and rock: explicit material point method (2D plane strain)", argc, argv,
+                     run);
+}

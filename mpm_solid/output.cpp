@@ -1,0 +1,59 @@
+#include "mpm_solid/output.hpp"
+
+#include <cmath>
+
+#include <fmt/format.h>
+
+namespace outburst::mpm {
+
+std::pair<double, double> principal_extremes(const Mat<2>& s, double s_zz) {
+  const double centre = 0.5 * (s(0, 0) + s(1, 1));
+  const double radius = std::hypot(0.5 * (s(0, 0) - s(1, 1)), s(0, 1));
+  return {std::max(centre + radius, s_zz), std::min(centre - radius, s_zz)};
+}
+
+Output::Output(const std::filesystem::path& directory, const output::RunInfo& info)
+    : series_(directory, "particles", info) {
+  series_.add_point_grid("particles");
+  history_.open(directory / "mpm_history.csv", std::ios::trunc);
+  history_ << "step,time_s,dt_s,particles,removed_total,kinetic_energy_J_per_m\n";
+  history_.flush();
+}
+
+void Output::snapshot(const Solver& solver) {
+  const auto& p = solver.particles();
+  const std::size_t n = p.size();
+  std::vector<double> xyz, velocity, displacement, stress, s_max, s_min, material, id;
+  xyz.reserve(3 * n);
+  for (std::size_t i = 0; i < n; ++i) {
+    xyz.insert(xyz.end(), {p.x[i].x(), p.x[i].y(), 0.0});
+    velocity.insert(velocity.end(), {p.v[i].x(), p.v[i].y(), 0.0});
+    const Vec<2> u = p.x[i] - p.x0[i];
+    displacement.insert(displacement.end(), {u.x(), u.y(), 0.0});
+    const Mat<2>& s = p.stress[i];
+    stress.insert(stress.end(), {s(0, 0), s(0, 1), 0.0, s(1, 1), 0.0, p.stress_zz[i]});
+    const auto [hi, lo] = principal_extremes(s, p.stress_zz[i]);
+    s_max.push_back(hi);
+    s_min.push_back(lo);
+    material.push_back(p.material[i]);
+    id.push_back(p.id[i]);
+  }
+  output::Snapshot snap(solver.time());
+  snap.set_points("particles", std::move(xyz));
+  snap.add("particles", {"velocity", output::Center::node, 3, "m/s", std::move(velocity)});
+  snap.add("particles", {"displacement", output::Center::node, 3, "m", std::move(displacement)});
+  snap.add("particles", {"stress", output::Center::node, 6, "Pa (tension positive)", std::move(stress)});
+  snap.add("particles", {"sigma_max", output::Center::node, 1, "Pa", std::move(s_max)});
+  snap.add("particles", {"sigma_min", output::Center::node, 1, "Pa", std::move(s_min)});
+  snap.add("particles", {"material", output::Center::node, 1, "", std::move(material)});
+  snap.add("particles", {"id", output::Center::node, 1, "", std::move(id)});
+  series_.write(snap);
+}
+
+void Output::history(const Solver& solver, const StepInfo& step) {
+  history_ << fmt::format("{},{:.17g},{:.17g},{},{},{:.17g}\n", solver.steps(), solver.time(), step.dt,
+                          solver.particles().size(), solver.removed_particles(), solver.kinetic_energy());
+  if (solver.steps() % 100 == 0) history_.flush();
+}
+
+}  // namespace outburst::mpm

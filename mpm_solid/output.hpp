@@ -1,0 +1,29 @@
+#pragma once
+// What an MPM run writes: particles as a point cloud for ParaView (velocity,
+// displacement, stress tensor, principal stresses, material, id) and a per-step
+// history CSV (time step, kinetic energy, particles removed), flushed line by line.
+
+#include <filesystem>
+#include <fstream>
+
+#include "common/field_output.hpp"
+#include "mpm_solid/solver.hpp"
+
+namespace outburst::mpm {
+
+// Largest and smallest principal stress of a plane-strain state (zz included).
+std::pair<double, double> principal_extremes(const Mat<2>& s, double s_zz);
+
+class Output {
+ public:
+  Output(const std::filesystem::path& directory, const output::RunInfo& info);
+  void snapshot(const Solver& solver);
+  void history(const Solver& solver, const StepInfo& step);
+  const output::FieldSeries& series() const { return series_; }
+
+ private:
+  output::FieldSeries series_;
+  std::ofstream history_;
+};
+
+}  // namespace outburst::mpm

@@ -1,0 +1,151 @@
+#include "mpm_solid/scene_reader.hpp"
+
+#include <cmath>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+namespace outburst::mpm {
+
+using scene::Key;
+using scene::Range;
+
+namespace {
+
+Wall read_wall(const scene::Table& t, std::string_view side, double friction) {
+  const std::string type = t.choice({side, "\"open\" (particles may leave), \"fixed\", \"roller\" (no normal "
+                                           "motion) or \"friction\" (Coulomb, unilateral)",
+                                     "open"},
+                                    {"open", "fixed", "roller", "friction"});
+  if (type == "fixed") return {Wall::Type::fixed, 0};
+  if (type == "roller") return {Wall::Type::roller, 0};
+  if (type == "friction") return {Wall::Type::friction, friction};
+  return {Wall::Type::open, 0};
+}
+
+// Even-odd rule point-in-polygon test.
+bool inside_polygon(const std::vector<Vec<2>>& poly, const Vec<2>& x) {
+  bool in = false;
+  for (std::size_t i = 0, j = poly.size() - 1; i < poly.size(); j = i++) {
+    const Vec<2>& a = poly[i];
+    const Vec<2>& b = poly[j];
+    if ((a.y() > x.y()) != (b.y() > x.y()) &&
+        x.x() < (b.x() - a.x()) * (x.y() - a.y()) / (b.y() - a.y()) + a.x())
+      in = !in;
+  }
+  return in;
+}
+
+}  // namespace
+
+Setup read_setup(const scene::Table& s) {
+  Setup setup;
+  Settings& st = setup.settings;
+  const std::string scheme = s.choice(
+      {"scheme", "\"usf\" (update stress first, the paper's), \"usl\" or \"musl\"", "usf"}, {"usf", "usl", "musl"});
+  st.scheme = scheme == "usf" ? Scheme::usf : scheme == "usl" ? Scheme::usl : Scheme::musl;
+  const std::string shape =
+      s.choice({"shape", "grid shape functions: \"linear\", \"gimp\" or \"bspline\" (quadratic)", "bspline"},
+               {"linear", "gimp", "bspline"});
+  st.shape = shape == "linear" ? ShapeKind::linear : shape == "gimp" ? ShapeKind::gimp : ShapeKind::bspline;
+  st.flip_fraction = s.number({"flip_fraction", "velocity update: 1 pure FLIP, 0 pure PIC", "0.99",
+                               Range::between(0, 1)});
+  st.courant = s.number({"courant", "time step as a fraction of the CFL limit h / (c + |v|)", "0.3",
+                         Range{0.0, 1.0, false, true}});
+  st.local_damping = s.number({"local_damping",
+                               "Cundall local damping coefficient (quasi-static stages; 0: off)", "0",
+                               Range::between(0, 1)});
+  const auto g = s.quantity_vector({"gravity", "gravitational acceleration", "0 m/s2, 0 m/s2"},
+                                   units::acceleration, 2);
+  st.gravity = {g[0], g[1]};
+  if (s.has("time_step"))
+    setup.fixed_time_step = s.quantity({"time_step", "fixed step instead of the CFL step (checked against it)",
+                                        "", Range::positive()},
+                                       units::time);
+
+  const auto grid = s.table("grid", "the background grid", true);
+  const auto origin = grid->quantity_vector({"origin", "lower-left corner", "0 m, 0 m"}, units::length, 2);
+  const auto size = grid->quantity_vector({"size", "width and height", "", Range::positive()}, units::length, 2);
+  const double h = grid->quantity({"cell_size", "edge of the square cells", "", Range::positive()}, units::length);
+  Grid<2>& gr = setup.grid;
+  gr.h = h;
+  gr.lower = {origin[0], origin[1]};
+  for (int d = 0; d < 2; ++d) {
+    const double n = size[d] / h;
+    gr.cells[d] = static_cast<int>(std::lround(n));
+    if (std::abs(n - gr.cells[d]) > 1e-9 * n || gr.cells[d] < 1)
+      grid->fail("cell_size", fmt::format("the grid size {:g} m is not a whole number of cells of {:g} m", size[d], h));
+  }
+  gr.upper = gr.lower + Vec<2>(gr.cells[0] * h, gr.cells[1] * h);
+
+  if (const auto walls = s.table("walls", "conditions on the grid's four edges", false)) {
+    const double mu = walls->number({"friction_coefficient", "Coulomb coefficient of \"friction\" walls", "0",
+                                     Range::non_negative()});
+    const char* sides[4] = {"left", "right", "bottom", "top"};
+    for (int w = 0; w < 4; ++w) st.walls[w] = read_wall(*walls, sides[w], mu);
+  }
+
+  std::vector<std::string> names;
+  for (const auto& m : s.table_array("materials", "constitutive models, referred to by name")) {
+    const std::string name = m.string({"name", "material name"});
+    if (std::find(names.begin(), names.end(), name) != names.end())
+      m.fail("name", fmt::format("material \"{}\" is defined twice", name));
+    m.choice({"model", "\"elastic\": linear elastic, Jaumann rate", "elastic"}, {"elastic"});
+    Elasticity e{};
+    e.density = m.quantity({"density", "mass density", "", Range::positive()}, units::density);
+    e.youngs_modulus = m.quantity({"youngs_modulus", "Young's modulus E", "", Range::positive()}, units::pressure);
+    e.poisson_ratio = m.number({"poisson_ratio", "Poisson's ratio", "", Range{-1.0, 0.5, false, false}});
+    setup.materials.push_back(std::make_unique<LinearElastic>(name, e));
+    names.push_back(name);
+  }
+  if (names.empty()) s.fail("materials", "give at least one [[mpm.materials]]");
+
+  const auto bodies = s.table_array("bodies", "regions filled with particles");
+  if (bodies.empty()) s.fail("bodies", "give at least one [[mpm.bodies]] to fill with particles");
+  for (const auto& b : bodies) {
+    const std::string material = b.string({"material", "name of one of the [[mpm.materials]]"});
+    const auto found = std::find(names.begin(), names.end(), material);
+    if (found == names.end())
+      b.fail("material", fmt::format("no material \"{}\" (defined: {})", material, fmt::join(names, ", ")));
+    const int index = static_cast<int>(found - names.begin());
+    const int ppc = static_cast<int>(b.integer({"particles_per_cell", "n for n x n particles per cell", "2",
+                                                Range::between(1, 8)}));
+    std::vector<Vec<2>> points;
+    if (b.has("polygon")) {
+      std::vector<Vec<2>> polygon;
+      for (const auto& v : b.quantity_points({"polygon", "vertices [[\"x m\", \"y m\"], ...] in order"},
+                                             units::length))
+        polygon.emplace_back(v[0], v[1]);
+      if (polygon.size() < 3) b.fail("polygon", "a polygon needs at least 3 vertices");
+      Vec<2> lo = polygon[0], hi = polygon[0];
+      for (const auto& v : polygon) {
+        lo = lo.cwiseMin(v);
+        hi = hi.cwiseMax(v);
+      }
+      fill_cells(gr, ppc, lo, hi, [&](const Vec<2>& x) { return inside_polygon(polygon, x); }, points);
+    } else {
+      const auto lo = b.quantity_vector({"box_min", "lower-left corner of a rectangular body"}, units::length, 2);
+      const auto hi = b.quantity_vector({"box_max", "upper-right corner of a rectangular body"}, units::length, 2);
+      const Vec<2> lov(lo[0], lo[1]), hiv(hi[0], hi[1]);
+      if (!((hiv.array() > lov.array()).all())) b.fail("box_max", "must lie above and right of box_min");
+      fill_cells(gr, ppc, lov, hiv, [](const Vec<2>&) { return true; }, points);
+    }
+    if (points.empty())
+      b.fail(b.has("polygon") ? "polygon" : "box_min", "the body holds no particle positions of the grid");
+    const auto v0 = b.quantity_vector({"initial_velocity", "velocity at t = 0", "0 m/s, 0 m/s"}, units::velocity, 2);
+    const auto s0 = b.quantity_vector({"initial_stress", "in-situ stress xx, yy, xy (tension positive)",
+                                       "0 Pa, 0 Pa, 0 Pa"},
+                                      units::pressure, 3);
+    const auto& e = setup.materials[index]->elasticity();
+    Mat<2> stress;
+    stress << s0[0], s0[2], s0[2], s0[1];
+    const double stress_zz = e.poisson_ratio * (s0[0] + s0[1]);  // plane strain
+    const double volume = (h / ppc) * (h / ppc);
+    for (const auto& x : points)
+      setup.particles.add(x, Vec<2>(v0[0], v0[1]), e.density * volume, volume, 0.5 / ppc, stress, stress_zz,
+                          index);
+  }
+  return setup;
+}
+
+}  // namespace outburst::mpm
