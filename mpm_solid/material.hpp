@@ -49,4 +49,37 @@ class LinearElastic final : public Material {
   void update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const override;
 };
 
+// The elastic trial step shared by the elastic-plastic models: Jaumann-rate
+// linear elasticity over dt, in place.
+void elastic_trial(const Elasticity& e, const Mat<2>& velocity_gradient, double dt, Mat<2>& stress,
+                   double& stress_zz);
+
+// Drucker-Prager perfect plasticity fitted to Mohr-Coulomb (paper eqs. 36-37):
+//   f = alpha I1/3 + sqrt(J2) - k,   tension positive,
+// with a plastic potential of the same form using the dilation angle (0 by
+// default: plastic flow keeps the volume). Return mapping to the cone, or to
+// its apex when the cone return would overshoot it (hydrostatic tension).
+struct DruckerPragerFit {
+  enum class Kind { outer, inner, plane_strain };
+  // alpha and k of f = alpha I1/3 + sqrt(J2) - k.
+  static std::pair<double, double> coefficients(Kind kind, double cohesion, double friction_angle);
+};
+
+class DruckerPrager final : public Material {
+ public:
+  DruckerPrager(std::string name, Elasticity elasticity, double cohesion, double friction_angle,
+                double dilation_angle, DruckerPragerFit::Kind fit);
+  void update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const override;
+
+  double alpha() const { return alpha_; }
+  double k() const { return k_; }
+  // The yield function of a plane-strain stress state.
+  double yield(const Mat<2>& stress, double stress_zz) const;
+  // Return the trial stress to the yield surface; returns the plastic multiplier.
+  double return_map(Mat<2>& stress, double& stress_zz) const;
+
+ private:
+  double alpha_, k_, alpha_dilation_;
+};
+
 }  // namespace outburst::mpm

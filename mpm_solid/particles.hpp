@@ -24,6 +24,7 @@ struct Particles {
   std::vector<Mat<Dim>> deformation;        // F
   std::vector<Mat<Dim>> affine;             // APIC's B matrix
   std::vector<Vec<Dim>> external_force;     // set by another program [N per m]
+  std::vector<double> plastic_strain;       // equivalent plastic strain (accumulated)
   std::vector<std::int32_t> material;       // index into the scene's materials
   std::vector<std::int32_t> id;             // stable identity (tracers, output)
 
@@ -45,6 +46,7 @@ struct Particles {
     deformation.push_back(Mat<Dim>::Identity());
     affine.push_back(Mat<Dim>::Zero());
     external_force.push_back(Vec<Dim>::Zero());
+    plastic_strain.push_back(0.0);
     material.push_back(material_index);
     id.push_back(static_cast<std::int32_t>(id.size()));
   }
@@ -68,6 +70,7 @@ struct Particles {
         deformation[to] = deformation[from];
         affine[to] = affine[from];
         external_force[to] = external_force[from];
+        plastic_strain[to] = plastic_strain[from];
         material[to] = material[from];
         id[to] = id[from];
       }
@@ -91,6 +94,7 @@ struct Particles {
     deformation.resize(n);
     affine.resize(n);
     external_force.resize(n);
+    plastic_strain.resize(n);
     material.resize(n);
     id.resize(n);
   }

@@ -90,12 +90,34 @@ Setup read_setup(const scene::Table& s) {
     const std::string name = m.string({"name", "material name"});
     if (std::find(names.begin(), names.end(), name) != names.end())
       m.fail("name", fmt::format("material \"{}\" is defined twice", name));
-    m.choice({"model", "\"elastic\": linear elastic, Jaumann rate", "elastic"}, {"elastic"});
+    const std::string model = m.choice(
+        {"model", "\"elastic\" (Jaumann rate) or \"drucker_prager\" (perfectly plastic)", "elastic"},
+        {"elastic", "drucker_prager"});
     Elasticity e{};
     e.density = m.quantity({"density", "mass density", "", Range::positive()}, units::density);
     e.youngs_modulus = m.quantity({"youngs_modulus", "Young's modulus E", "", Range::positive()}, units::pressure);
     e.poisson_ratio = m.number({"poisson_ratio", "Poisson's ratio", "", Range{-1.0, 0.5, false, false}});
-    setup.materials.push_back(std::make_unique<LinearElastic>(name, e));
+    if (model == "elastic") {
+      setup.materials.push_back(std::make_unique<LinearElastic>(name, e));
+    } else {
+      const double c = m.quantity({"cohesion", "Mohr-Coulomb cohesion c", "", Range::non_negative()}, units::pressure);
+      const double phi = m.quantity({"friction_angle", "Mohr-Coulomb friction angle", "",
+                                     Range{0.0, 1.5, true, false}},
+                                    units::angle);
+      const double psi = m.quantity({"dilation_angle", "dilation angle of the plastic potential (0: no volume "
+                                                       "change in plastic flow)",
+                                     "0 deg", Range::non_negative()},
+                                    units::angle);
+      if (psi > phi) m.fail("dilation_angle", "must not exceed the friction angle");
+      const std::string fit = m.choice({"fit", "Drucker-Prager cone fitted to Mohr-Coulomb: \"outer\" "
+                                               "(compression corners, the paper's), \"inner\" or \"plane_strain\"",
+                                        "outer"},
+                                       {"outer", "inner", "plane_strain"});
+      const auto kind = fit == "outer"   ? DruckerPragerFit::Kind::outer
+                        : fit == "inner" ? DruckerPragerFit::Kind::inner
+                                         : DruckerPragerFit::Kind::plane_strain;
+      setup.materials.push_back(std::make_unique<DruckerPrager>(name, e, c, phi, psi, kind));
+    }
     names.push_back(name);
   }
   if (names.empty()) s.fail("materials", "give at least one [[mpm.materials]]");

@@ -105,7 +105,7 @@ template <class Shape>
 void Solver::scatter_mass_momentum() {
   const auto& p = particles_;
   const int n = static_cast<int>(p.size());
-#pragma omp parallel
+#pragma omp parallel num_threads(static_cast<int>(thread_mass_.size()))
   {
     auto& m = thread_mass_[omp_get_thread_num()];
     auto& mv = thread_vector_[omp_get_thread_num()];
@@ -165,7 +165,7 @@ void Solver::scatter_forces() {
   const auto& p = particles_;
   const int n = static_cast<int>(p.size());
   const Vec<2> g = settings_.gravity;
-#pragma omp parallel
+#pragma omp parallel num_threads(static_cast<int>(thread_mass_.size()))
   {
     auto& f = thread_vector_[omp_get_thread_num()];
     Stencil2<Shape> s;

@@ -1,26 +1,29 @@
-// Every shipped seepage scene is valid: read fully, no unknown keys.
+// Every shipped scene is valid: read fully by its solvers, no unknown keys.
 #include <catch2/catch.hpp>
 
 #include <filesystem>
 
 #include "common/program.hpp"
+#include "mpm_solid/scene_reader.hpp"
 #include "seepage_fe/scene_reader.hpp"
 
 using namespace outburst;
 
-TEST_CASE("shipped seepage scenes are valid", "[scene][cases]") {
+TEST_CASE("shipped scenes are valid", "[scene][cases]") {
   int checked = 0;
   for (const auto& entry :
        std::filesystem::recursive_directory_iterator(std::string(OUTBURST_SOURCE_DIR) + "/cases")) {
     if (entry.path().extension() != ".toml") continue;
+    INFO(entry.path().string());
     auto doc = scene::Document::load(entry.path());
     auto root = doc->root();
     const auto header = read_scene_header(root);
-    if (header.solvers != std::vector<std::string>{"seepage"}) continue;
-    INFO(entry.path().string());
-    REQUIRE_NOTHROW(seepage::read_setup(*root.table("seepage", "", true)));
+    for (const auto& solver : header.solvers) {
+      if (solver == "seepage") REQUIRE_NOTHROW(seepage::read_setup(*root.table("seepage", "", true)));
+      if (solver == "mpm") REQUIRE_NOTHROW(mpm::read_setup(*root.table("mpm", "", true)));
+    }
     REQUIRE_NOTHROW(doc->reject_unused());
     ++checked;
   }
-  CHECK(checked >= 1);
+  CHECK(checked >= 2);
 }

@@ -1,0 +1,109 @@
+// Single-point stress paths of the constitutive models against hand-computed
+// answers: one particle driven by a prescribed velocity gradient.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+
+#include "mpm_solid/material.hpp"
+
+using namespace outburst;
+using namespace outburst::mpm;
+
+namespace {
+
+constexpr double deg = 3.14159265358979323846 / 180;
+const Elasticity coal{1600, 6e9, 0.4};
+
+Particles<2> one_particle() {
+  Particles<2> p;
+  p.add(Vec<2>::Zero(), Vec<2>::Zero(), 1, 1, 0.25, Mat<2>::Zero(), 0, 0);
+  return p;
+}
+
+// Drive the particle with a constant velocity gradient for `steps` of dt.
+void drive(const Material& m, Particles<2>& p, const Mat<2>& l, int steps, double dt) {
+  p.velocity_gradient[0] = l;
+  for (int s = 0; s < steps; ++s) m.update_stress(p, {0}, dt);
+}
+
+}  // namespace
+
+TEST_CASE("Drucker-Prager coefficients match the paper's outer-cone fit", "[mpm][material]") {
+  const auto [alpha, k] = DruckerPragerFit::coefficients(DruckerPragerFit::Kind::outer, 1e6, 30 * deg);
+  CHECK(alpha == Approx(0.6928).epsilon(1e-4));  // model-notes section 4
+  CHECK(k == Approx(1.2e6).epsilon(1e-4));
+  // The inner cone is inside the outer one; the plane-strain fit inside both.
+  const auto inner = DruckerPragerFit::coefficients(DruckerPragerFit::Kind::inner, 1e6, 30 * deg);
+  const auto plane = DruckerPragerFit::coefficients(DruckerPragerFit::Kind::plane_strain, 1e6, 30 * deg);
+  CHECK(inner.second < k);
+  CHECK(plane.second < inner.second);
+}
+
+TEST_CASE("elastic Jaumann rate: uniaxial strain and a rigid rotation", "[mpm][material]") {
+  LinearElastic m("coal", coal);
+  auto p = one_particle();
+  Mat<2> l = Mat<2>::Zero();
+  l(0, 0) = -1e-3;  // compress along x at 1e-3 /s for 1 s
+  drive(m, p, l, 100, 0.01);
+  const double lambda = coal.lame_lambda(), g = coal.shear_modulus();
+  CHECK(p.stress[0](0, 0) == Approx(-(lambda + 2 * g) * 1e-3).epsilon(1e-12));
+  CHECK(p.stress[0](1, 1) == Approx(-lambda * 1e-3).epsilon(1e-12));
+  CHECK(p.stress_zz[0] == Approx(-lambda * 1e-3).epsilon(1e-12));
+  // A pure spin rotates the stress without changing its invariants.
+  const Mat<2> before = p.stress[0];
+  Mat<2> spin;
+  spin << 0, -1, 1, 0;  // rotation at 1 rad/s
+  drive(m, p, spin, 10000, 3.14159265358979 / 2 / 10000);  // a quarter turn in small steps
+  CHECK(p.stress[0].trace() == Approx(before.trace()).epsilon(1e-9));
+  CHECK(p.stress[0].determinant() == Approx(before.determinant()).epsilon(1e-3));
+  CHECK(p.stress[0](0, 0) == Approx(before(1, 1)).epsilon(1e-3));  // axes swapped
+}
+
+TEST_CASE("Drucker-Prager compression with shear stays on the cone as computed by hand",
+          "[mpm][material]") {
+  // Compress along x, stretch along y a little less: volume shrinks slowly while
+  // shear grows until the cone is reached. With no dilation, plastic flow keeps
+  // the volume, so the mean stress is K times the total volumetric strain, and
+  // on the cone sqrt(J2) = k - alpha * mean.
+  DruckerPrager m("coal", coal, 1e6, 30 * deg, 0.0, DruckerPragerFit::Kind::outer);
+  auto p = one_particle();
+  Mat<2> l = Mat<2>::Zero();
+  l(0, 0) = -1.0;
+  l(1, 1) = 0.9;
+  const double strain = 2e-3;  // yield starts near 3.6e-4
+  drive(m, p, l, 2000, strain / 2000);
+  const double bulk = coal.lame_lambda() + 2.0 / 3.0 * coal.shear_modulus();
+  const double mean = (p.stress[0].trace() + p.stress_zz[0]) / 3;
+  CHECK(mean == Approx(-bulk * 0.1 * strain).epsilon(1e-9));
+  CHECK(m.yield(p.stress[0], p.stress_zz[0]) == Approx(0).margin(1e-9 * m.k()));
+  const Mat<2> dev = p.stress[0] - mean * Mat<2>::Identity();
+  const double sqrt_j2 = std::sqrt(0.5 * (dev.squaredNorm() + std::pow(p.stress_zz[0] - mean, 2)));
+  CHECK(sqrt_j2 == Approx(m.k() - m.alpha() * mean).epsilon(1e-9));
+  CHECK(p.plastic_strain[0] > 0);
+}
+
+TEST_CASE("Drucker-Prager tension returns to the apex: hydrostatic k / alpha", "[mpm][material]") {
+  DruckerPrager m("coal", coal, 1e6, 30 * deg, 0.0, DruckerPragerFit::Kind::outer);
+  auto p = one_particle();
+  Mat<2> l = Mat<2>::Zero();
+  l(0, 0) = 1.0;
+  drive(m, p, l, 100, 1e-5);  // 1e-3 of extension, far past the apex
+  const double apex = m.k() / m.alpha();  // mean stress at the apex, tension
+  CHECK(p.stress[0](0, 0) == Approx(apex).epsilon(1e-12));
+  CHECK(p.stress[0](1, 1) == Approx(apex).epsilon(1e-12));
+  CHECK(p.stress_zz[0] == Approx(apex).epsilon(1e-12));
+  CHECK(std::abs(p.stress[0](0, 1)) < 1e-9 * apex);
+}
+
+TEST_CASE("Drucker-Prager below the yield surface is elastic", "[mpm][material]") {
+  DruckerPrager plastic("coal", coal, 1e6, 30 * deg, 0.0, DruckerPragerFit::Kind::outer);
+  LinearElastic elastic("coal", coal);
+  auto a = one_particle(), b = one_particle();
+  Mat<2> l = Mat<2>::Zero();
+  l(0, 0) = -1e-5;
+  drive(plastic, a, l, 10, 1.0);
+  drive(elastic, b, l, 10, 1.0);
+  CHECK(plastic.yield(a.stress[0], a.stress_zz[0]) < 0);
+  CHECK(a.stress[0] == b.stress[0]);
+  CHECK(a.plastic_strain[0] == 0);
+}
