@@ -33,6 +33,7 @@ int run(const RunOptions& options, scene::Document& doc) {
   mpm::Output out(options.output_directory(), run_info("mpm-solid", doc, "SI: m, s, kg, Pa; 2D plane strain, "
                                                                          "per metre of depth"));
   out.snapshot(solver);
+  double last_snapshot_time = 0;
   Progress progress("mpm", 0.0, header.end_time, options.show_progress());
   double next_output = header.output_interval;
   while (solver.time() < header.end_time * (1 - 1e-12)) {
@@ -44,12 +45,15 @@ int run(const RunOptions& options, scene::Document& doc) {
       out.history(solver, info);
       if (info.removed > 0) spdlog::debug("{} particles left the grid at t = {:.6g} s", info.removed, solver.time());
     } catch (const mpm::SimulationError&) {
-      out.snapshot(solver);  // the last state, for a look at what went wrong
+      progress.finish();
+      spdlog::error("the last good state is the last snapshot written, at t = {:.6g} s, in {}",
+                    last_snapshot_time, std::filesystem::absolute(out.series().index_path()).string());
       throw;
     }
     progress.update(solver.steps(), solver.time(), dt, fmt::format("particles {}", solver.particles().size()));
     if (solver.time() >= target * (1 - 1e-12)) {
       out.snapshot(solver);
+      last_snapshot_time = solver.time();
       next_output += header.output_interval;
     }
   }
