@@ -1,9 +1,6 @@
 #include "common/program.hpp"
 
 #include <omp.h>
-#include <unistd.h>
-
-#include <cstdlib>
 
 #include <algorithm>
 
@@ -73,16 +70,8 @@ bool finish_reading(const RunOptions& options, const scene::Document& doc) {
   return true;
 }
 
-void limit_openmp_threads_to_cores(char** argv) {
-  if (std::getenv("OMP_THREAD_LIMIT")) return;
-  const long cores = ::sysconf(_SC_NPROCESSORS_ONLN);
-  ::setenv("OMP_THREAD_LIMIT", std::to_string(std::max(1L, cores)).c_str(), 1);
-  ::execv("/proc/self/exe", argv);  // returns only on failure: then run without the cap
-}
-
 int run_program(const std::string& program, const std::string& description, int argc, char** argv,
                 const std::function<int(const RunOptions&, scene::Document&)>& run) {
-  limit_openmp_threads_to_cores(argv);
   CLI::App app(description, program);
   RunOptions options;
   app.add_option("scene", options.scene, "Scene file (TOML)")->required()->check(CLI::ExistingFile);

@@ -31,12 +31,6 @@ struct RunOptions {
   bool show_progress() const;
 };
 
-// Debian's CHOLMOD runs its OpenMP regions with 4 threads whatever the machine;
-// on 2 cores that oversubscription makes large factorisations 2x slower. The
-// only cap libgomp honours is OMP_THREAD_LIMIT, read when the library loads, so
-// a program without it sets it to the core count and re-executes itself once.
-void limit_openmp_threads_to_cores(char** argv);
-
 // Parse the command line, set up logging and threads, load the scene, and call
 // `run` with the loaded document. Returns the process exit code.
 int run_program(const std::string& program, const std::string& description, int argc, char** argv,

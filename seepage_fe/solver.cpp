@@ -305,7 +305,7 @@ std::optional<std::string> Solver::try_step(double h, int& iterations) {
       build_jacobian(trial_, a0, h);
       {
         ScopedTimer timer(timings_.factorization);
-        factor_.factorize(jacobian_);
+        blas::without_openmp_regions([&] { factor_.factorize(jacobian_); });
         ++timings_.factorizations;
       }
       if (factor_.info() != Eigen::Success) {

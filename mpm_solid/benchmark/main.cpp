@@ -12,7 +12,6 @@
 #include <cstdio>
 #include <cstdlib>
 
-#include "common/program.hpp"
 #include "mpm_solid/scene_reader.hpp"
 #include "mpm_solid/solver.hpp"
 
@@ -62,7 +61,6 @@ double particle_steps_per_second(long particles, ShapeKind shape, bool plastic, 
 }  // namespace
 
 int main(int argc, char** argv) {
-  limit_openmp_threads_to_cores(argv);
   std::vector<long> sizes;
   for (int i = 1; i < argc; ++i) sizes.push_back(std::atol(argv[i]));
   if (sizes.empty()) sizes = {10000, 100000, 1000000};

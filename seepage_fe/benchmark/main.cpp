@@ -12,7 +12,6 @@
 #include <Eigen/CholmodSupport>
 
 #include "common/blas.hpp"
-#include "common/program.hpp"
 #include "seepage_fe/solver.hpp"
 
 using namespace outburst;
@@ -37,7 +36,7 @@ double bare_factor_and_solve(const Eigen::SparseMatrix<double>& j, int mode, int
   f.analyzePattern(j);
   const auto start = Clock::now();
   for (int r = 0; r < reps; ++r) {
-    f.factorize(j);
+    blas::without_openmp_regions([&] { f.factorize(j); });
     x = f.solve(b);
   }
   if (f.info() != Eigen::Success) std::fprintf(stderr, "bare factorisation failed\n");
@@ -47,7 +46,6 @@ double bare_factor_and_solve(const Eigen::SparseMatrix<double>& j, int mode, int
 }  // namespace
 
 int main(int argc, char** argv) {
-  limit_openmp_threads_to_cores(argv);
   std::vector<int> sides;
   for (int i = 1; i < argc; ++i) sides.push_back(std::atoi(argv[i]));
   if (sides.empty()) sides = {99, 315, 999};
