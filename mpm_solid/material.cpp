@@ -19,13 +19,14 @@ void elastic_trial(const Elasticity& e, const Mat<2>& l, double dt, Mat<2>& s, d
   s_zz += dt * e.lame_lambda() * trace;
 }
 
-void LinearElastic::update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const {
+double LinearElastic::update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const {
   const int n = static_cast<int>(members.size());
 #pragma omp parallel for schedule(static)
   for (int k = 0; k < n; ++k) {
     const int i = members[k];
     elastic_trial(elasticity(), p.velocity_gradient[i], dt, p.stress[i], p.stress_zz[i]);
   }
+  return 0;
 }
 
 std::pair<double, double> DruckerPragerFit::coefficients(Kind kind, double c, double phi) {
@@ -71,6 +72,12 @@ Invariants invariants(const Mat<2>& s, double s_zz) {
 
 }  // namespace
 
+double Material::strain_energy_density(const Mat<2>& s, double s_zz) const {
+  const auto inv = invariants(s, s_zz);
+  const double g = elasticity_.shear_modulus(), bulk = elasticity_.lame_lambda() + 2.0 / 3.0 * g;
+  return inv.sqrt_j2 * inv.sqrt_j2 / (2 * g) + inv.mean * inv.mean / (2 * bulk);
+}
+
 double DruckerPrager::yield(const Mat<2>& s, double s_zz) const {
   const auto inv = invariants(s, s_zz);
   return alpha_ * inv.mean + inv.sqrt_j2 - k_;
@@ -100,16 +107,29 @@ double DruckerPrager::return_map(Mat<2>& s, double& s_zz) const {
   return dlambda;
 }
 
-void DruckerPrager::update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const {
+double DruckerPrager::update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const {
   const int n = static_cast<int>(members.size());
   // Equivalent plastic strain per unit multiplier: sqrt(2/3 |dg/dsigma|^2).
   const double strain_per_multiplier = std::sqrt(2.0 / 3.0 * (0.5 + alpha_dilation_ * alpha_dilation_ / 3));
-#pragma omp parallel for schedule(static)
+  const double g = elasticity().shear_modulus();
+  const double bulk = elasticity().lame_lambda() + 2.0 / 3.0 * g;
+  double dissipated = 0;
+#pragma omp parallel for schedule(static) reduction(+ : dissipated)
   for (int k = 0; k < n; ++k) {
     const int i = members[k];
     elastic_trial(elasticity(), p.velocity_gradient[i], dt, p.stress[i], p.stress_zz[i]);
-    p.plastic_strain[i] += strain_per_multiplier * return_map(p.stress[i], p.stress_zz[i]);
+    const auto trial = invariants(p.stress[i], p.stress_zz[i]);
+    const double multiplier = return_map(p.stress[i], p.stress_zz[i]);
+    if (multiplier == 0) continue;
+    p.plastic_strain[i] += strain_per_multiplier * multiplier;
+    // Plastic work sigma : C^-1 : (sigma_trial - sigma) of the return.
+    const auto after = invariants(p.stress[i], p.stress_zz[i]);
+    const double deviatoric = ((after.deviator.array() * (trial.deviator - after.deviator).array()).sum() +
+                               after.deviator_zz * (trial.deviator_zz - after.deviator_zz)) /
+                              (2 * g);
+    dissipated += p.volume[i] * (deviatoric + after.mean * (trial.mean - after.mean) / bulk);
   }
+  return dissipated;
 }
 
 }  // namespace outburst::mpm

@@ -34,8 +34,12 @@ class Material {
   const Elasticity& elasticity() const { return elasticity_; }
 
   // Update the stresses of particles `members` over a step dt from their
-  // velocity gradients (objective: Jaumann rate, paper eqs. 31-33).
-  virtual void update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const = 0;
+  // velocity gradients (objective: Jaumann rate, paper eqs. 31-33). Returns the
+  // energy dissipated in the step [J per m of depth].
+  virtual double update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const = 0;
+
+  // Elastic strain energy density of a stress state [J/m^3].
+  double strain_energy_density(const Mat<2>& stress, double stress_zz) const;
 
  private:
   std::string name_;
@@ -46,7 +50,7 @@ class Material {
 class LinearElastic final : public Material {
  public:
   using Material::Material;
-  void update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const override;
+  double update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const override;
 };
 
 // The elastic trial step shared by the elastic-plastic models: Jaumann-rate
@@ -69,7 +73,7 @@ class DruckerPrager final : public Material {
  public:
   DruckerPrager(std::string name, Elasticity elasticity, double cohesion, double friction_angle,
                 double dilation_angle, DruckerPragerFit::Kind fit);
-  void update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const override;
+  double update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const override;
 
   double alpha() const { return alpha_; }
   double k() const { return k_; }

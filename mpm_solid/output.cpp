@@ -16,11 +16,13 @@ Output::Output(const std::filesystem::path& directory, const output::RunInfo& in
     : series_(directory, "particles", info) {
   series_.add_point_grid("particles");
   history_.open(directory / "mpm_history.csv", std::ios::trunc);
-  history_ << "step,time_s,dt_s,particles,removed_total,kinetic_energy_J_per_m\n";
+  history_ << "step,time_s,dt_s,particles,removed_total,kinetic_J_per_m,strain_J_per_m,gravity_J_per_m,"
+              "plastic_J_per_m,damping_J_per_m,walls_J_per_m,external_work_J_per_m,balance_error_J_per_m\n";
   history_.flush();
 }
 
 void Output::snapshot(const Solver& solver) {
+  if (!initial_total_) initial_total_ = solver.energies().total();
   const auto& p = solver.particles();
   const std::size_t n = p.size();
   std::vector<double> xyz, velocity, displacement, stress, s_max, s_min, material, id;
@@ -51,8 +53,12 @@ void Output::snapshot(const Solver& solver) {
 }
 
 void Output::history(const Solver& solver, const StepInfo& step) {
-  history_ << fmt::format("{},{:.17g},{:.17g},{},{},{:.17g}\n", solver.steps(), solver.time(), step.dt,
-                          solver.particles().size(), solver.removed_particles(), solver.kinetic_energy());
+  const Energies e = solver.energies();
+  if (!initial_total_) initial_total_ = e.total();
+  history_ << fmt::format("{},{:.17g},{:.17g},{},{},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.6g}\n",
+                          solver.steps(), solver.time(), step.dt, solver.particles().size(),
+                          solver.removed_particles(), e.kinetic, e.strain, e.gravity, e.plastic, e.damping, e.walls,
+                          e.external, e.total() - *initial_total_);
   if (solver.steps() % 100 == 0) history_.flush();
 }
 

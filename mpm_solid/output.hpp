@@ -1,10 +1,11 @@
 #pragma once
 // What an MPM run writes: particles as a point cloud for ParaView (velocity,
 // displacement, stress tensor, principal stresses, material, id) and a per-step
-// history CSV (time step, kinetic energy, particles removed), flushed line by line.
+// history CSV (time step, particles, the energy account and its balance error).
 
 #include <filesystem>
 #include <fstream>
+#include <optional>
 
 #include "common/field_output.hpp"
 #include "mpm_solid/solver.hpp"
@@ -24,6 +25,7 @@ class Output {
  private:
   output::FieldSeries series_;
   std::ofstream history_;
+  std::optional<double> initial_total_;  // energy total when the history starts
 };
 
 }  // namespace outburst::mpm

@@ -150,7 +150,8 @@ void Solver::gather_velocity_gradient() {
 }
 
 void Solver::update_stresses(double dt) {
-  for (std::size_t m = 0; m < materials_.size(); ++m) materials_[m]->update_stress(particles_, members_[m], dt);
+  for (std::size_t m = 0; m < materials_.size(); ++m)
+    dissipated_.plastic += materials_[m]->update_stress(particles_, members_[m], dt);
   auto& p = particles_;
   const int n = static_cast<int>(p.size());
 #pragma omp parallel for schedule(static)
@@ -183,16 +184,22 @@ void Solver::scatter_forces() {
 void Solver::grid_update(double dt) {
   const std::size_t n = mass_.size();
   if (const double alpha = settings_.local_damping; alpha > 0) {
-#pragma omp parallel for schedule(static)
+    double work = 0;
+#pragma omp parallel for schedule(static) reduction(+ : work)
     for (std::size_t i = 0; i < n; ++i)
       for (int d = 0; d < 2; ++d)
-        if (velocity_[i][d] != 0) force_[i][d] -= alpha * std::abs(force_[i][d]) * std::copysign(1.0, velocity_[i][d]);
+        if (velocity_[i][d] != 0) {
+          const double damping = alpha * std::abs(force_[i][d]);
+          force_[i][d] -= damping * std::copysign(1.0, velocity_[i][d]);
+          work += damping * std::abs(velocity_[i][d]) * dt;
+        }
+    dissipated_.damping += work;
   }
 #pragma omp parallel for schedule(static)
   for (std::size_t i = 0; i < n; ++i)
     velocity_new_[i] = mass_[i] > empty_node_mass_ ? Vec<2>(velocity_[i] + dt * force_[i] / mass_[i])
                                                    : Vec<2>::Zero();
-  apply_walls(velocity_new_);
+  dissipated_.walls += apply_walls(velocity_new_);
 }
 
 // Walls sit on the physical domain's edges, on a row of nodes. The wall node
@@ -201,10 +208,12 @@ void Solver::grid_update(double dt) {
 // condition at the wall itself and not half a cell inside (which costs wide
 // shape functions a whole order of accuracy). Friction walls act only on nodes
 // moving into them: the normal velocity is removed and the tangential one
-// reduced by mu times that change.
-void Solver::apply_walls(std::vector<Vec<2>>& velocity) const {
+// reduced by mu times that change. Returns the work done by friction (fixed and
+// roller walls do none: the wall does not move).
+double Solver::apply_walls(std::vector<Vec<2>>& velocity) const {
   const int g = Grid<2>::ghost;
   const std::size_t n = velocity.size();
+  double friction_work = 0;
   // Wall rows first, then ghost rows outward, so that every mirror is final
   // when it is read (thin domains mirror one wall's ghosts in the other's).
   for (int depth = 0; depth <= g; ++depth) {
@@ -214,7 +223,7 @@ void Solver::apply_walls(std::vector<Vec<2>>& velocity) const {
       const int axis = side / 2, t = 1 - axis;
       const int outward = side % 2 == 0 ? -1 : 1;  // wall normal, out of the domain
       const int wall_row = outward < 0 ? g : g + grid_.cells[axis];
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) reduction(+ : friction_work)
       for (std::size_t i = 0; i < n; ++i) {
         const auto& ij = node_ij_[i];
         if ((ij[axis] - wall_row) * outward != depth) continue;
@@ -235,6 +244,8 @@ void Solver::apply_walls(std::vector<Vec<2>>& velocity) const {
             if (vn <= 0) break;  // separating
             v[axis] = 0;
             const double reduced = std::max(std::abs(v[t]) - wall.friction * vn, 0.0);
+            // Work of the friction impulse m (|v_t| - reduced) against the sliding.
+            friction_work += mass_[i] * (std::abs(v[t]) - reduced) * reduced;
             v[t] = std::copysign(reduced, v[t]);
             break;
           }
@@ -243,6 +254,7 @@ void Solver::apply_walls(std::vector<Vec<2>>& velocity) const {
       }
     }
   }
+  return friction_work;
 }
 
 template <class Shape>
@@ -324,6 +336,12 @@ void Solver::remove_escaped(StepInfo& info) {
 StepInfo Solver::step(double dt) {
   StepInfo info{dt};
   (this->*kernel_)(dt);
+  double work = 0;
+  const auto& p = particles_;
+  const int count = static_cast<int>(p.size());
+#pragma omp parallel for schedule(static) reduction(+ : work)
+  for (int i = 0; i < count; ++i) work += p.external_force[i].dot(p.v[i]) * dt;
+  dissipated_.external += work;
   remove_escaped(info);
   time_ += dt;
   ++steps_;
@@ -331,12 +349,31 @@ StepInfo Solver::step(double dt) {
 }
 
 void Solver::restore_state(const State& s) {
+  dissipated_ = s.dissipated;
   time_ = s.time;
   steps_ = s.steps;
   removed_ = s.removed;
   const bool same_particles = s.particles.size() == particles_.size();
   particles_ = s.particles;
   if (!same_particles) rebuild_material_groups();
+}
+
+Energies Solver::energies() const {
+  Energies e = dissipated_;
+  const auto& p = particles_;
+  const int n = static_cast<int>(p.size());
+  const Vec<2> g = settings_.gravity;
+  double kinetic = 0, strain = 0, gravity = 0;
+#pragma omp parallel for schedule(static) reduction(+ : kinetic, strain, gravity)
+  for (int i = 0; i < n; ++i) {
+    kinetic += 0.5 * p.mass[i] * p.v[i].squaredNorm();
+    strain += p.volume[i] * materials_[p.material[i]]->strain_energy_density(p.stress[i], p.stress_zz[i]);
+    gravity -= p.mass[i] * g.dot(p.x[i] - grid_.lower);
+  }
+  e.kinetic = kinetic;
+  e.strain = strain;
+  e.gravity = gravity;
+  return e;
 }
 
 double Solver::kinetic_energy() const {

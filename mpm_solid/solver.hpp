@@ -55,6 +55,21 @@ class SimulationError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// Energies per metre of depth [J/m]. Stored ones are computed from the current
+// state; dissipated and external ones accumulate over the run. With the
+// gravitational potential measured from the grid's lower edge,
+//   kinetic + strain + gravity + plastic + damping + walls - external
+// stays constant but for what the method itself dissipates: the balance error.
+// That holds the grid's velocity projections, including the kinetic energy a
+// wall removes from material moving into it (an inelastic impact, or O(dt)
+// per unit time for material resting on it); `walls` counts friction only.
+struct Energies {
+  double kinetic = 0, strain = 0, gravity = 0;
+  double plastic = 0, damping = 0, walls = 0;  // dissipated so far (walls: friction)
+  double external = 0;                         // work of the external forces so far
+  double total() const { return kinetic + strain + gravity + plastic + damping + walls - external; }
+};
+
 struct StepInfo {
   double dt;
   std::size_t removed = 0;  // particles that left the grid this step
@@ -89,11 +104,13 @@ class Solver {
     long steps;
     std::size_t removed;
     Particles<2> particles;
+    Energies dissipated;
   };
-  State save_state() const { return {time_, steps_, removed_, particles_}; }
+  State save_state() const { return {time_, steps_, removed_, particles_, dissipated_}; }
   void restore_state(const State& s);
 
   double kinetic_energy() const;
+  Energies energies() const;
 
  private:
   template <class Shape, Scheme S>
@@ -108,7 +125,7 @@ class Solver {
   void gather_motion(double dt);
   void grid_velocities();
   void grid_update(double dt);
-  void apply_walls(std::vector<Vec<2>>& velocity) const;
+  double apply_walls(std::vector<Vec<2>>& velocity) const;
   void update_stresses(double dt);
   void remove_escaped(StepInfo& info);
   void rebuild_material_groups();
@@ -133,6 +150,7 @@ class Solver {
   double time_ = 0;
   long steps_ = 0;
   std::size_t removed_ = 0;
+  Energies dissipated_;  // only the accumulated members are used
 };
 
 }  // namespace outburst::mpm
