@@ -31,7 +31,8 @@ int run(const RunOptions& options, scene::Document& doc) {
 
   const auto wall_start = std::chrono::steady_clock::now();
   mpm::Output out(options.output_directory(), run_info("mpm-solid", doc, "SI: m, s, kg, Pa; 2D plane strain, "
-                                                                         "per metre of depth"));
+                                                                         "per metre of depth"),
+                  setup.tracers);
   out.snapshot(solver);
   double last_snapshot_time = 0;
   Progress progress("mpm", 0.0, header.end_time, options.show_progress());

@@ -1,5 +1,6 @@
 #include "mpm_solid/output.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -12,8 +13,13 @@ std::pair<double, double> principal_extremes(const Mat<2>& s, double s_zz) {
   return {std::max(centre + radius, s_zz), std::min(centre - radius, s_zz)};
 }
 
-Output::Output(const std::filesystem::path& directory, const output::RunInfo& info)
-    : series_(directory, "particles", info) {
+Output::Output(const std::filesystem::path& directory, const output::RunInfo& info, std::vector<int> tracers)
+    : series_(directory, "particles", info), tracers_(std::move(tracers)) {
+  if (!tracers_.empty()) {
+    tracer_file_.open(directory / "tracers.csv", std::ios::trunc);
+    tracer_file_ << "time_s,tracer,particle_id,x_m,y_m,vx_m_per_s,vy_m_per_s,speed_m_per_s,ux_m,uy_m,"
+                    "sigma_max_Pa,sigma_min_Pa,plastic_strain\n";
+  }
   series_.add_point_grid("particles");
   history_.open(directory / "mpm_history.csv", std::ios::trunc);
   history_ << "step,time_s,dt_s,particles,removed_total,kinetic_J_per_m,strain_J_per_m,gravity_J_per_m,"
@@ -59,7 +65,19 @@ void Output::history(const Solver& solver, const StepInfo& step) {
                           solver.steps(), solver.time(), step.dt, solver.particles().size(),
                           solver.removed_particles(), e.kinetic, e.strain, e.gravity, e.plastic, e.damping, e.walls,
                           e.external, e.total() - *initial_total_);
-  if (solver.steps() % 100 == 0) history_.flush();
+  history_.flush();
+  if (tracers_.empty()) return;
+  const auto& p = solver.particles();
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const auto found = std::find(tracers_.begin(), tracers_.end(), p.id[i]);
+    if (found == tracers_.end()) continue;
+    const Vec<2> u = p.x[i] - p.x0[i];
+    const auto [hi, lo] = principal_extremes(p.stress[i], p.stress_zz[i]);
+    tracer_file_ << fmt::format("{:.10g},{},{},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.6g}\n",
+                                solver.time(), found - tracers_.begin(), p.id[i], p.x[i].x(), p.x[i].y(), p.v[i].x(),
+                                p.v[i].y(), p.v[i].norm(), u.x(), u.y(), hi, lo, p.plastic_strain[i]);
+  }
+  tracer_file_.flush();
 }
 
 }  // namespace outburst::mpm

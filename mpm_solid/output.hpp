@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <optional>
+#include <vector>
 
 #include "common/field_output.hpp"
 #include "mpm_solid/solver.hpp"
@@ -17,7 +18,8 @@ std::pair<double, double> principal_extremes(const Mat<2>& s, double s_zz);
 
 class Output {
  public:
-  Output(const std::filesystem::path& directory, const output::RunInfo& info);
+  // `tracers`: ids of particles whose state is written every step to tracers.csv.
+  Output(const std::filesystem::path& directory, const output::RunInfo& info, std::vector<int> tracers);
   void snapshot(const Solver& solver);
   void history(const Solver& solver, const StepInfo& step);
   const output::FieldSeries& series() const { return series_; }
@@ -26,6 +28,8 @@ class Output {
   output::FieldSeries series_;
   std::ofstream history_;
   std::optional<double> initial_total_;  // energy total when the history starts
+  std::vector<int> tracers_;
+  std::ofstream tracer_file_;
 };
 
 }  // namespace outburst::mpm

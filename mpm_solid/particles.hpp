@@ -24,6 +24,7 @@ struct Particles {
   std::vector<Mat<Dim>> deformation;        // F
   std::vector<Mat<Dim>> affine;             // APIC's B matrix
   std::vector<Vec<Dim>> external_force;     // set by another program [N per m]
+  std::vector<Vec<Dim>> surface_force;      // boundary tractions of the scene [N per m]
   std::vector<double> plastic_strain;       // equivalent plastic strain (accumulated)
   std::vector<std::int32_t> material;       // index into the scene's materials
   std::vector<std::int32_t> id;             // stable identity (tracers, output)
@@ -46,6 +47,7 @@ struct Particles {
     deformation.push_back(Mat<Dim>::Identity());
     affine.push_back(Mat<Dim>::Zero());
     external_force.push_back(Vec<Dim>::Zero());
+    surface_force.push_back(Vec<Dim>::Zero());
     plastic_strain.push_back(0.0);
     material.push_back(material_index);
     id.push_back(static_cast<std::int32_t>(id.size()));
@@ -70,6 +72,7 @@ struct Particles {
         deformation[to] = deformation[from];
         affine[to] = affine[from];
         external_force[to] = external_force[from];
+        surface_force[to] = surface_force[from];
         plastic_strain[to] = plastic_strain[from];
         material[to] = material[from];
         id[to] = id[from];
@@ -94,6 +97,7 @@ struct Particles {
     deformation.resize(n);
     affine.resize(n);
     external_force.resize(n);
+    surface_force.resize(n);
     plastic_strain.resize(n);
     material.resize(n);
     id.resize(n);

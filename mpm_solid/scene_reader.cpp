@@ -1,6 +1,7 @@
 #include "mpm_solid/scene_reader.hpp"
 
 #include <cmath>
+#include <limits>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -34,6 +35,37 @@ bool inside_polygon(const std::vector<Vec<2>>& poly, const Vec<2>& x) {
       in = !in;
   }
   return in;
+}
+
+// A traction loads the outermost layer of particles facing one way inside a
+// box: each carries the traction times its share of the surface (its spacing).
+void read_tractions(const scene::Table& s, Setup& setup) {
+  auto& p = setup.particles;
+  for (const auto& t : s.table_array("tractions", "constant loads on body surfaces (the crustal stress)")) {
+    const auto lo = t.quantity_vector({"box_min", "lower-left corner of the box holding the loaded surface"},
+                                      units::length, 2);
+    const auto hi = t.quantity_vector({"box_max", "upper-right corner of that box"}, units::length, 2);
+    const std::string facing = t.choice({"surface", "which surface of the particles in the box: the one facing "
+                                                    "\"up\", \"down\", \"left\" or \"right\""},
+                                        {"up", "down", "left", "right"});
+    const auto value = t.quantity_vector({"traction", "force per area [x, y] on that surface (compression "
+                                                      "pushes into the body)"},
+                                         units::pressure, 2);
+    const int axis = facing == "up" || facing == "down" ? 1 : 0;
+    const double sign = facing == "up" || facing == "right" ? 1.0 : -1.0;
+    std::vector<std::size_t> inside;
+    double extreme = -std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < p.size(); ++i)
+      if (p.x[i].x() >= lo[0] && p.x[i].x() <= hi[0] && p.x[i].y() >= lo[1] && p.x[i].y() <= hi[1]) {
+        inside.push_back(i);
+        extreme = std::max(extreme, sign * p.x[i][axis]);
+      }
+    if (inside.empty()) t.fail("box_min", "the box holds no particle to load");
+    for (std::size_t i : inside) {
+      const double spacing = 2 * p.half_width[i] * setup.grid.h;
+      if (sign * p.x[i][axis] >= extreme - 0.5 * spacing) p.surface_force[i] += Vec<2>(value[0], value[1]) * spacing;
+    }
+  }
 }
 
 }  // namespace
@@ -166,6 +198,19 @@ Setup read_setup(const scene::Table& s) {
     for (const auto& x : points)
       setup.particles.add(x, Vec<2>(v0[0], v0[1]), e.density * volume, volume, 0.5 / ppc, stress, stress_zz,
                           index);
+  }
+  read_tractions(s, setup);
+
+  if (s.has("tracers")) {
+    for (const auto& point : s.quantity_points({"tracers", "points [[\"x\", \"y\"], ...]: the particle nearest "
+                                                           "each at t = 0 has its history written"},
+                                               units::length)) {
+      const Vec<2> x(point[0], point[1]);
+      std::size_t nearest = 0;
+      for (std::size_t i = 1; i < setup.particles.size(); ++i)
+        if ((setup.particles.x[i] - x).squaredNorm() < (setup.particles.x[nearest] - x).squaredNorm()) nearest = i;
+      setup.tracers.push_back(setup.particles.id[nearest]);
+    }
   }
   return setup;
 }

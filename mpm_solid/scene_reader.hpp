@@ -17,6 +17,7 @@ struct Setup {
   Particles<2> particles;
   Settings settings;
   std::optional<double> fixed_time_step;  // [s]; otherwise the CFL step each step
+  std::vector<int> tracers;               // particle ids whose histories are written
 };
 
 Setup read_setup(const scene::Table& mpm);

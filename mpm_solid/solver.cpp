@@ -174,7 +174,7 @@ void Solver::scatter_forces() {
     for (int i = 0; i < n; ++i) {
       s.compute(grid_, p.x[i], p.half_width[i]);
       const Mat<2> vs = p.volume[i] * p.stress[i];
-      const Vec<2> body = p.mass[i] * g + p.external_force[i];
+      const Vec<2> body = p.mass[i] * g + p.external_force[i] + p.surface_force[i];
       for (int k = 0; k < s.count; ++k) f[s.node[k]] += s.weight[k] * body - vs * s.gradient[k];
     }
   }
@@ -340,7 +340,7 @@ StepInfo Solver::step(double dt) {
   const auto& p = particles_;
   const int count = static_cast<int>(p.size());
 #pragma omp parallel for schedule(static) reduction(+ : work)
-  for (int i = 0; i < count; ++i) work += p.external_force[i].dot(p.v[i]) * dt;
+  for (int i = 0; i < count; ++i) work += (p.external_force[i] + p.surface_force[i]).dot(p.v[i]) * dt;
   dissipated_.external += work;
   remove_escaped(info);
   time_ += dt;

@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "common/program.hpp"
 #include "mpm_fixtures.hpp"
 
 using namespace outburst;
@@ -65,4 +66,54 @@ TEST_CASE("a block slides down a frictional slope at g (sin t - mu cos t)", "[mp
               t_end, x / m, 0.5 * a * t_end * t_end, v / m, a * t_end);
   CHECK(v / m == Approx(a * t_end).epsilon(0.03));
   CHECK(x / m == Approx(0.5 * a * t_end * t_end).epsilon(0.03));
+}
+
+TEST_CASE("a traction on the top surface loads the block to sigma_yy = -t", "[mpm][traction]") {
+  // Read through the scene reader, as a user writes it.
+  auto doc = scene::Document::parse(R"toml(
+[scene]
+solvers = ["mpm"]
+end_time = "1 s"
+[mpm]
+shape = "gimp"
+local_damping = 0.7
+tracers = [["0.5 m", "1.9 m"]]
+[mpm.grid]
+size = ["1 m", "2.5 m"]
+cell_size = "0.1 m"
+[mpm.walls]
+left = "roller"
+right = "roller"
+bottom = "fixed"
+[[mpm.materials]]
+name = "rock"
+density = "2500 kg/m3"
+youngs_modulus = "1 GPa"
+poisson_ratio = 0.25
+[[mpm.bodies]]
+material = "rock"
+box_min = ["0 m", "0 m"]
+box_max = ["1 m", "2 m"]
+[[mpm.tractions]]
+box_min = ["0 m", "1.5 m"]
+box_max = ["1 m", "2 m"]
+surface = "up"
+traction = ["0 Pa", "-1.5 MPa"]
+)toml",
+                                    "traction.toml");
+  auto root = doc->root();
+  read_scene_header(root);
+  auto setup = read_setup(*root.table("mpm", "", true));
+  doc->reject_unused();
+  REQUIRE(setup.tracers.size() == 1);
+  Solver solver(setup.grid, std::move(setup.materials), std::move(setup.particles), setup.settings);
+  for (int i = 0; i < 3000; ++i) solver.step(solver.stable_time_step());
+  // The load acts on the top particles and spreads through the top cell: the
+  // particles in that cell carry part of it; below, the stress is uniform.
+  double worst = 0;
+  for (std::size_t i = 0; i < solver.particles().size(); ++i)
+    if (solver.particles().x0[i].y() < 2 - 0.1)
+      worst = std::max(worst, std::abs(solver.particles().stress[i](1, 1) + 1.5e6));
+  std::printf("\ntop traction 1.5 MPa: worst |sigma_yy + t| = %.3g Pa below the loaded cell\n", worst);
+  CHECK(worst < 0.01 * 1.5e6);
 }
