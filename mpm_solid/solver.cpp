@@ -91,7 +91,9 @@ void Solver::rebuild_material_groups() {
 
 double Solver::stable_time_step() const {
   double fastest = 0;
-  for (std::size_t p = 0; p < particles_.size(); ++p) {
+  const int n = static_cast<int>(particles_.size());
+#pragma omp parallel for schedule(static) reduction(max : fastest)
+  for (int p = 0; p < n; ++p) {
     const auto& e = materials_[particles_.material[p]]->elasticity();
     // The wave speed grows as the material compresses (density rises).
     const double density = particles_.mass[p] / particles_.volume[p];
@@ -305,32 +307,39 @@ void Solver::step_kernel(double dt) {
     gather_velocity_gradient<Shape>();
     update_stresses(dt);
   }
-  for (std::size_t i = 0; i < particles_.size(); ++i) particles_.x[i] += displacement_[i];
+  const int n = static_cast<int>(particles_.size());
+#pragma omp parallel for schedule(static)
+  for (int i = 0; i < n; ++i) particles_.x[i] += displacement_[i];
 }
 
 void Solver::remove_escaped(StepInfo& info) {
   auto& p = particles_;
-  std::vector<char> keep(p.size(), 1);
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    if (!p.x[i].allFinite() || !p.v[i].allFinite() || !p.stress[i].allFinite()) {
+  const int n = static_cast<int>(p.size());
+  long bad = 0, escaped = 0;
+#pragma omp parallel for schedule(static) reduction(+ : bad, escaped)
+  for (int i = 0; i < n; ++i) {
+    if (!p.x[i].allFinite() || !p.v[i].allFinite() || !p.stress[i].allFinite())
+      ++bad;
+    else if (!grid_.inside(p.x[i]))
+      ++escaped;
+  }
+  if (bad > 0)
+    for (int i = 0; i < n; ++i) {
+      if (p.x[i].allFinite() && p.v[i].allFinite() && p.stress[i].allFinite()) continue;
       const char* field = !p.x[i].allFinite() ? "position" : !p.v[i].allFinite() ? "velocity" : "stress";
       throw SimulationError(fmt::format(
           "mpm: step {} (t = {:.6g} s): particle {} (material \"{}\") has a non-finite {}; the time "
           "step may exceed the stable one, or a material parameter is out of range",
           steps_ + 1, time_, p.id[i], materials_[p.material[i]]->name(), field));
     }
-    if (!grid_.inside(p.x[i])) {
-      keep[i] = 0;
-      ++info.removed;
-    }
-  }
-  if (info.removed > 0) {
-    if (info.removed == p.size())
-      throw SimulationError(fmt::format("mpm: step {}: every particle has left the grid", steps_ + 1));
-    p.keep(keep);
-    removed_ += info.removed;
-    rebuild_material_groups();
-  }
+  if (escaped == 0) return;
+  if (escaped == n) throw SimulationError(fmt::format("mpm: step {}: every particle has left the grid", steps_ + 1));
+  std::vector<char> keep(p.size());
+  for (int i = 0; i < n; ++i) keep[i] = grid_.inside(p.x[i]);
+  p.keep(keep);
+  info.removed = static_cast<std::size_t>(escaped);
+  removed_ += info.removed;
+  rebuild_material_groups();
 }
 
 StepInfo Solver::step(double dt) {
