@@ -80,8 +80,11 @@ Setup read_setup(const scene::Table& s) {
       s.choice({"shape", "grid shape functions: \"linear\", \"gimp\" or \"bspline\" (quadratic)", "bspline"},
                {"linear", "gimp", "bspline"});
   st.shape = shape == "linear" ? ShapeKind::linear : shape == "gimp" ? ShapeKind::gimp : ShapeKind::bspline;
-  st.flip_fraction = s.number({"flip_fraction", "velocity update: 1 pure FLIP, 0 pure PIC", "0.99",
-                               Range::between(0, 1)});
+  st.apic = s.choice({"transfer", "velocity transfer: \"flip\" (FLIP/PIC blend) or \"apic\" (affine PIC)", "flip"},
+                     {"flip", "apic"}) == "apic";
+  if (!st.apic)
+    st.flip_fraction = s.number({"flip_fraction", "FLIP/PIC blend: 1 pure FLIP, 0 pure PIC", "0.99",
+                                 Range::between(0, 1)});
   st.courant = s.number({"courant", "time step as a fraction of the CFL limit h / (c + |v|)", "0.3",
                          Range{0.0, 1.0, false, true}});
   st.local_damping = s.number({"local_damping",

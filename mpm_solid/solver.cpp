@@ -69,11 +69,14 @@ Solver::Solver(Grid<2> grid, std::vector<std::unique_ptr<Material>> materials,
   rebuild_material_groups();
 
   // One kernel per (shape, scheme), chosen here once.
+  const auto with_transfer = [&]<class Shape, Scheme S>() -> void (Solver::*)(double) {
+    return settings_.apic ? &Solver::step_kernel<Shape, S, true> : &Solver::step_kernel<Shape, S, false>;
+  };
   const auto pick = [&]<class Shape>() -> void (Solver::*)(double) {
     switch (settings_.scheme) {
-      case Scheme::usf: return &Solver::step_kernel<Shape, Scheme::usf>;
-      case Scheme::usl: return &Solver::step_kernel<Shape, Scheme::usl>;
-      case Scheme::musl: return &Solver::step_kernel<Shape, Scheme::musl>;
+      case Scheme::usf: return with_transfer.template operator()<Shape, Scheme::usf>();
+      case Scheme::usl: return with_transfer.template operator()<Shape, Scheme::usl>();
+      case Scheme::musl: return with_transfer.template operator()<Shape, Scheme::musl>();
     }
     return nullptr;
   };
@@ -103,7 +106,7 @@ double Solver::stable_time_step() const {
   return settings_.courant * grid_.h / fastest;
 }
 
-template <class Shape>
+template <class Shape, bool Apic>
 void Solver::scatter_mass_momentum() {
   const auto& p = particles_;
   const int n = static_cast<int>(p.size());
@@ -114,11 +117,14 @@ void Solver::scatter_mass_momentum() {
     Stencil2<Shape> s;
 #pragma omp for schedule(static)
     for (int i = 0; i < n; ++i) {
-      s.compute(grid_, p.x[i], p.half_width[i]);
+      s.template compute<Apic>(grid_, p.x[i], p.half_width[i]);
       for (int k = 0; k < s.count; ++k) {
         const double wm = s.weight[k] * p.mass[i];
         m[s.node[k]] += wm;
-        mv[s.node[k]] += wm * p.v[i];
+        if constexpr (Apic)
+          mv[s.node[k]] += wm * (p.v[i] + p.affine[i] * s.offset[k]);
+        else
+          mv[s.node[k]] += wm * p.v[i];
       }
     }
   }
@@ -259,7 +265,7 @@ double Solver::apply_walls(std::vector<Vec<2>>& velocity) const {
   return friction_work;
 }
 
-template <class Shape>
+template <class Shape, bool Apic>
 void Solver::gather_motion(double dt) {
   auto& p = particles_;
   const int n = static_cast<int>(p.size());
@@ -269,25 +275,40 @@ void Solver::gather_motion(double dt) {
     Stencil2<Shape> s;
 #pragma omp for schedule(static)
     for (int i = 0; i < n; ++i) {
-      s.compute(grid_, p.x[i], p.half_width[i]);
+      s.template compute<Apic>(grid_, p.x[i], p.half_width[i]);
       Vec<2> v_pic = Vec<2>::Zero(), dv = Vec<2>::Zero();
+      Mat<2> b = Mat<2>::Zero();
+      Vec<2> d = Vec<2>::Zero();  // diagonal of D = sum w (x_i - x_p)(x_i - x_p)^T
       for (int k = 0; k < s.count; ++k) {
         const auto node = s.node[k];
         v_pic += s.weight[k] * velocity_new_[node];
-        dv += s.weight[k] * (velocity_new_[node] - velocity_[node]);
+        if constexpr (Apic) {
+          b += s.weight[k] * velocity_new_[node] * s.offset[k].transpose();
+          d += s.weight[k] * s.offset[k].cwiseProduct(s.offset[k]);
+        } else {
+          dv += s.weight[k] * (velocity_new_[node] - velocity_[node]);
+        }
       }
       displacement_[i] = dt * v_pic;
-      p.v[i] = flip * (p.v[i] + dv) + (1 - flip) * v_pic;
+      if constexpr (Apic) {
+        // D is diagonal for tensor-product shapes that reproduce linear fields;
+        // a particle on a linear-shape node has D = 0 along that axis (and B too).
+        p.v[i] = v_pic;
+        for (int c = 0; c < 2; ++c)
+          p.affine[i].col(c) = d[c] > 1e-12 * grid_.h * grid_.h ? Vec<2>(b.col(c) / d[c]) : Vec<2>::Zero();
+      } else {
+        p.v[i] = flip * (p.v[i] + dv) + (1 - flip) * v_pic;
+      }
     }
   }
 }
 
 // Every transfer of a step uses the particles' positions at its start; they move
 // at the end.
-template <class Shape, Scheme S>
+template <class Shape, Scheme S, bool Apic>
 void Solver::step_kernel(double dt) {
   displacement_.resize(particles_.size());
-  scatter_mass_momentum<Shape>();
+  scatter_mass_momentum<Shape, Apic>();
   grid_velocities();
   if constexpr (S == Scheme::usf) {
     gather_velocity_gradient<Shape>();
@@ -295,11 +316,11 @@ void Solver::step_kernel(double dt) {
   }
   scatter_forces<Shape>();
   grid_update(dt);
-  gather_motion<Shape>(dt);
+  gather_motion<Shape, Apic>(dt);
   if constexpr (S == Scheme::musl) {
     // Map the updated particle momentum back and take the velocity gradient of
     // that field: empty-ish nodes no longer carry the grid update's noise.
-    scatter_mass_momentum<Shape>();
+    scatter_mass_momentum<Shape, Apic>();
     grid_velocities();
   }
   if constexpr (S != Scheme::usf) {

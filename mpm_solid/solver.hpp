@@ -37,7 +37,11 @@ struct Wall {
 struct Settings {
   Scheme scheme = Scheme::usf;
   ShapeKind shape = ShapeKind::bspline;
-  double flip_fraction = 0.99;  // 1: pure FLIP, 0: pure PIC
+  // Velocity transfer: FLIP/PIC blend (1: pure FLIP, 0: pure PIC), or APIC
+  // (affine particle-in-cell: PIC plus a velocity gradient per particle, which
+  // conserves angular momentum without FLIP's noise).
+  bool apic = false;
+  double flip_fraction = 0.99;
   double courant = 0.3;
   Vec<2> gravity = Vec<2>::Zero();
   // Local (Cundall) damping coefficient for quasi-static stages: each nodal
@@ -113,15 +117,15 @@ class Solver {
   Energies energies() const;
 
  private:
-  template <class Shape, Scheme S>
+  template <class Shape, Scheme S, bool Apic>
   void step_kernel(double dt);
-  template <class Shape>
+  template <class Shape, bool Apic>
   void scatter_mass_momentum();
   template <class Shape>
   void scatter_forces();
   template <class Shape>
   void gather_velocity_gradient();
-  template <class Shape>
+  template <class Shape, bool Apic>
   void gather_motion(double dt);
   void grid_velocities();
   void grid_update(double dt);

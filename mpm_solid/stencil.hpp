@@ -16,13 +16,17 @@ struct Stencil {
   std::array<std::size_t, count> node;
   std::array<double, count> weight;
   std::array<Vec<Dim>, count> gradient;  // d N / d x [1/m]
+  std::array<Vec<Dim>, count> offset;    // x_node - x_particle [m], only with Offsets
 
   // Returns false when a node of the support lies outside the (ghost-padded) grid.
+  template <bool Offsets = false>
   bool compute(const Grid<Dim>& g, const Vec<Dim>& x, double half_width) {
-    double w[Dim][support], dw[Dim][support];
+    double w[Dim][support], dw[Dim][support], rel[Dim];
     std::array<int, Dim> base;
     for (int d = 0; d < Dim; ++d) {
-      base[d] = Shape::eval(g.grid_coordinate(x[d], d), half_width, w[d], dw[d]);
+      const double xi = g.grid_coordinate(x[d], d);
+      base[d] = Shape::eval(xi, half_width, w[d], dw[d]);
+      rel[d] = (base[d] - xi) * g.h;
       if (base[d] < 0 || base[d] + support > g.nodes_along(d)) return false;
     }
     const double inv_h = 1.0 / g.h;
@@ -33,6 +37,7 @@ struct Stencil {
           node[k] = g.index({base[0] + i, base[1] + j});
           weight[k] = w[0][i] * w[1][j];
           gradient[k] = Vec<Dim>(dw[0][i] * w[1][j], w[0][i] * dw[1][j]) * inv_h;
+          if constexpr (Offsets) offset[k] = Vec<Dim>(rel[0] + i * g.h, rel[1] + j * g.h);
         }
     } else {
       for (int l = 0; l < support; ++l)
@@ -43,6 +48,7 @@ struct Stencil {
             gradient[k] = Vec<Dim>(dw[0][i] * w[1][j] * w[2][l], w[0][i] * dw[1][j] * w[2][l],
                                    w[0][i] * w[1][j] * dw[2][l]) *
                           inv_h;
+            if constexpr (Offsets) offset[k] = Vec<Dim>(rel[0] + i * g.h, rel[1] + j * g.h, rel[2] + l * g.h);
           }
     }
     return true;
