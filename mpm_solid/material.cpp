@@ -83,7 +83,7 @@ double DruckerPrager::yield(const Mat<2>& s, double s_zz) const {
   return alpha_ * inv.mean + inv.sqrt_j2 - k_;
 }
 
-double DruckerPrager::return_map(Mat<2>& s, double& s_zz) const {
+double DruckerPrager::return_map(Mat<2>& s, double& s_zz, double* work_density) const {
   const auto inv = invariants(s, s_zz);
   const double f = alpha_ * inv.mean + inv.sqrt_j2 - k_;
   if (f <= 0) return 0;
@@ -104,6 +104,10 @@ double DruckerPrager::return_map(Mat<2>& s, double& s_zz) const {
   const double scale = inv.sqrt_j2 > 0 ? sqrt_j2 / inv.sqrt_j2 : 0.0;
   s = mean * Mat<2>::Identity() + scale * inv.deviator;
   s_zz = mean + scale * inv.deviator_zz;
+  // Plastic work sigma : C^-1 : (sigma_trial - sigma): the deviator only shrinks
+  // along itself, so its part is sqrt(J2) (sqrt(J2)_trial - sqrt(J2)) / G.
+  if (work_density)
+    *work_density = sqrt_j2 * (inv.sqrt_j2 - sqrt_j2) / g + mean * (inv.mean - mean) / bulk;
   return dlambda;
 }
 
@@ -111,23 +115,16 @@ double DruckerPrager::update_stress(Particles<2>& p, const std::vector<int>& mem
   const int n = static_cast<int>(members.size());
   // Equivalent plastic strain per unit multiplier: sqrt(2/3 |dg/dsigma|^2).
   const double strain_per_multiplier = std::sqrt(2.0 / 3.0 * (0.5 + alpha_dilation_ * alpha_dilation_ / 3));
-  const double g = elasticity().shear_modulus();
-  const double bulk = elasticity().lame_lambda() + 2.0 / 3.0 * g;
   double dissipated = 0;
 #pragma omp parallel for schedule(static) reduction(+ : dissipated)
   for (int k = 0; k < n; ++k) {
     const int i = members[k];
     elastic_trial(elasticity(), p.velocity_gradient[i], dt, p.stress[i], p.stress_zz[i]);
-    const auto trial = invariants(p.stress[i], p.stress_zz[i]);
-    const double multiplier = return_map(p.stress[i], p.stress_zz[i]);
+    double work = 0;
+    const double multiplier = return_map(p.stress[i], p.stress_zz[i], &work);
     if (multiplier == 0) continue;
     p.plastic_strain[i] += strain_per_multiplier * multiplier;
-    // Plastic work sigma : C^-1 : (sigma_trial - sigma) of the return.
-    const auto after = invariants(p.stress[i], p.stress_zz[i]);
-    const double deviatoric = ((after.deviator.array() * (trial.deviator - after.deviator).array()).sum() +
-                               after.deviator_zz * (trial.deviator_zz - after.deviator_zz)) /
-                              (2 * g);
-    dissipated += p.volume[i] * (deviatoric + after.mean * (trial.mean - after.mean) / bulk);
+    dissipated += p.volume[i] * work;
   }
   return dissipated;
 }

@@ -79,8 +79,9 @@ class DruckerPrager final : public Material {
   double k() const { return k_; }
   // The yield function of a plane-strain stress state.
   double yield(const Mat<2>& stress, double stress_zz) const;
-  // Return the trial stress to the yield surface; returns the plastic multiplier.
-  double return_map(Mat<2>& stress, double& stress_zz) const;
+  // Return the trial stress to the yield surface; returns the plastic multiplier
+  // and, if asked, the plastic work density of the return [J/m^3].
+  double return_map(Mat<2>& stress, double& stress_zz, double* work_density = nullptr) const;
 
  private:
   double alpha_, k_, alpha_dilation_;
