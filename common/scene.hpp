@@ -45,7 +45,6 @@ struct Range {
   static Range non_negative() { return {0.0, std::nullopt, true, true}; }
   static Range at_least(double v) { return {v, std::nullopt, true, true}; }
   static Range between(double lo, double hi) { return {lo, hi, true, true}; }
-  static Range unit_interval_open_left() { return {0.0, 1.0, false, true}; }
   std::string describe() const;
   bool contains(double v) const;
 };

@@ -30,13 +30,6 @@ class TimeFunction {
     return (1.0 - w) * lower->second + w * upper->second;
   }
 
-  bool is_constant() const { return points_.size() == 1; }
-  double min_value() const {
-    return std::min_element(points_.begin(), points_.end(),
-                            [](const auto& a, const auto& b) { return a.second < b.second; })
-        ->second;
-  }
-
  private:
   std::vector<std::pair<double, double>> points_{{0.0, 0.0}};
 };

@@ -256,9 +256,4 @@ Quantity parse_quantity(std::string_view text) {
   return {value * unit.si, unit.dimension};
 }
 
-std::string format_in(double si_value, std::string_view unit_expression) {
-  const Quantity unit = parse_unit(unit_expression);
-  return fmt::format("{:g} {}", si_value / unit.si, unit_expression);
-}
-
 }  // namespace outburst::units

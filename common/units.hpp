@@ -63,9 +63,6 @@ class UnitError : public std::runtime_error {
 // either "m^2", "m2", "MPa^-0.5". A bare number is dimensionless.
 Quantity parse_quantity(std::string_view text);
 
-// Format an SI value in a unit expression (inverse of parse), e.g. for messages.
-std::string format_in(double si_value, std::string_view unit_expression);
-
 // SI value of one unit expression ("MPa" -> 1e6); throws UnitError.
 Quantity parse_unit(std::string_view unit_expression);
 
