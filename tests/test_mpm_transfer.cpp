@@ -51,7 +51,7 @@ double spin_kept(ShapeKind shape, bool apic, double flip, int steps) {
 
 }  // namespace
 
-TEST_CASE("APIC conserves angular momentum; PIC dissipates it", "[mpm][transfer]") {
+TEST_CASE("APIC conserves angular momentum where PIC dissipates it", "[mpm][transfer]") {
   for (auto shape : {ShapeKind::bspline, ShapeKind::gimp, ShapeKind::linear}) {
     const double apic = spin_kept(shape, true, 0, 400);
     const double pic = spin_kept(shape, false, 0.0, 400);

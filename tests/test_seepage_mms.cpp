@@ -106,7 +106,7 @@ TEST_CASE("backward Euler is first and BDF2 second order in time", "[seepage][mm
   }
 }
 
-TEST_CASE("Newton and Picard solve the same discrete equations; Newton in fewer iterations",
+TEST_CASE("Newton and Picard solve the same discrete equations, Newton in fewer iterations",
           "[seepage][mms]") {
   seepage::Settings newton, picard;
   picard.method = seepage::NonlinearMethod::picard;
