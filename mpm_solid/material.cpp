@@ -1,6 +1,7 @@
 #include "mpm_solid/material.hpp"
 
 #include <cmath>
+#include <algorithm>
 #include <tuple>
 
 namespace outburst::mpm {
@@ -83,21 +84,20 @@ double DruckerPrager::yield(const Mat<2>& s, double s_zz) const {
   return alpha_ * inv.mean + inv.sqrt_j2 - k_;
 }
 
-double DruckerPrager::return_map(Mat<2>& s, double& s_zz, double* work_density) const {
+double drucker_prager_return(double alpha, double k, double alpha_dilation, double g, double bulk, Mat<2>& s,
+                             double& s_zz, double* work_density) {
   const auto inv = invariants(s, s_zz);
-  const double f = alpha_ * inv.mean + inv.sqrt_j2 - k_;
+  const double f = alpha * inv.mean + inv.sqrt_j2 - k;
   if (f <= 0) return 0;
-  const double g = elasticity().shear_modulus();
-  const double bulk = elasticity().lame_lambda() + 2.0 / 3.0 * g;
   // Flow along dg/dsigma = (alpha_d / 3) I + s / (2 sqrt(J2)): the mean stress
   // drops by K alpha_d dlambda and sqrt(J2) by G dlambda.
-  double dlambda = f / (g + bulk * alpha_ * alpha_dilation_);
-  double mean = inv.mean - bulk * alpha_dilation_ * dlambda;
+  double dlambda = f / (g + bulk * alpha * alpha_dilation);
+  double mean = inv.mean - bulk * alpha_dilation * dlambda;
   double sqrt_j2 = inv.sqrt_j2 - g * dlambda;
   if (sqrt_j2 < 0) {
     // Past the apex (only a cone with alpha > 0 has one): the only admissible
     // state is hydrostatic tension at the apex.
-    mean = k_ / alpha_;
+    mean = k / alpha;
     sqrt_j2 = 0;
     dlambda = inv.sqrt_j2 / g;
   }
@@ -106,9 +106,14 @@ double DruckerPrager::return_map(Mat<2>& s, double& s_zz, double* work_density) 
   s_zz = mean + scale * inv.deviator_zz;
   // Plastic work sigma : C^-1 : (sigma_trial - sigma): the deviator only shrinks
   // along itself, so its part is sqrt(J2) (sqrt(J2)_trial - sqrt(J2)) / G.
-  if (work_density)
-    *work_density = sqrt_j2 * (inv.sqrt_j2 - sqrt_j2) / g + mean * (inv.mean - mean) / bulk;
+  if (work_density) *work_density = sqrt_j2 * (inv.sqrt_j2 - sqrt_j2) / g + mean * (inv.mean - mean) / bulk;
   return dlambda;
+}
+
+double DruckerPrager::return_map(Mat<2>& s, double& s_zz, double* work_density) const {
+  const double g = elasticity().shear_modulus();
+  return drucker_prager_return(alpha_, k_, alpha_dilation_, g, elasticity().lame_lambda() + 2.0 / 3.0 * g, s, s_zz,
+                               work_density);
 }
 
 double DruckerPrager::update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const {
@@ -125,6 +130,99 @@ double DruckerPrager::update_stress(Particles<2>& p, const std::vector<int>& mem
     if (multiplier == 0) continue;
     p.plastic_strain[i] += strain_per_multiplier * multiplier;
     dissipated += p.volume[i] * work;
+  }
+  return dissipated;
+}
+
+namespace {
+
+// In-plane principal values (a >= b) and the unit vector of a.
+struct Principal {
+  double a, b;
+  Vec<2> direction;
+};
+
+Principal principal(const Mat<2>& s) {
+  const double centre = 0.5 * (s(0, 0) + s(1, 1));
+  const double half = 0.5 * (s(0, 0) - s(1, 1));
+  const double radius = std::hypot(half, s(0, 1));
+  const double angle = 0.5 * std::atan2(s(0, 1), half);
+  return {centre + radius, centre - radius, Vec<2>(std::cos(angle), std::sin(angle))};
+}
+
+Mat<2> compose(double a, double b, const Vec<2>& direction) {
+  const Vec<2> normal(-direction.y(), direction.x());
+  return a * direction * direction.transpose() + b * normal * normal.transpose();
+}
+
+// Open cracks: tensile principal parts scaled by (1 - D) (or back, by 1/(1 - D)).
+double crack(double principal_value, double factor) { return principal_value > 0 ? factor * principal_value : principal_value; }
+
+}  // namespace
+
+ElasticDamage::ElasticDamage(std::string name, Elasticity elasticity, DamageParameters damage)
+    : Material(std::move(name), elasticity), parameters_(damage) {
+  std::tie(alpha_, k0_) =
+      DruckerPragerFit::coefficients(DruckerPragerFit::Kind::outer, damage.cohesion, damage.friction_angle);
+}
+
+double ElasticDamage::damage(double previous, const Mat<2>& effective, double effective_zz) const {
+  const auto& d = parameters_;
+  const double e0 = elasticity().youngs_modulus, nu = elasticity().poisson_ratio;
+  const Principal pr = principal(effective);
+  const double s1 = std::max(pr.a, effective_zz), s3 = std::min(pr.b, effective_zz);
+  const double s2 = pr.a + pr.b + effective_zz - s1 - s3;
+  const auto strain = [&](double si, double sj, double sk) { return (si - nu * (sj + sk)) / e0; };
+  double damage = previous;
+  if (s1 >= d.tensile_strength) {
+    const double eps1 = strain(s1, s2, s3), eps_t0 = d.tensile_strength / e0;
+    const double tensile =
+        eps1 >= d.ultimate_ratio * eps_t0 ? 1.0 : 1 - d.residual_ratio * d.tensile_strength / (e0 * eps1);
+    damage = std::max(damage, tensile);
+  }
+  const double sin_phi = std::sin(d.friction_angle), cos_phi = std::cos(d.friction_angle);
+  if (0.5 * (s1 - s3) >= d.cohesion * cos_phi - 0.5 * (s1 + s3) * sin_phi) {
+    const double eps3 = strain(s3, s1, s2);
+    const double ucs = 2 * d.cohesion * cos_phi / (1 - sin_phi);
+    if (eps3 < 0) damage = std::max(damage, 1 - d.residual_ratio * ucs / (e0 * -eps3));
+  }
+  return std::clamp(damage, 0.0, 1.0);
+}
+
+double ElasticDamage::update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const {
+  const int n = static_cast<int>(members.size());
+  const double g = elasticity().shear_modulus(), bulk = elasticity().lame_lambda() + 2.0 / 3.0 * g;
+  double dissipated = 0;
+#pragma omp parallel for schedule(static) reduction(+ : dissipated)
+  for (int k = 0; k < n; ++k) {
+    const int i = members[k];
+    Mat<2>& effective = p.effective_stress[i];
+    double& effective_zz = p.effective_stress_zz[i];
+    elastic_trial(elasticity(), p.velocity_gradient[i], dt, effective, effective_zz);
+    const double d = damage(p.damage[i], effective, effective_zz);
+    p.damage[i] = d;
+    // The stress acting: open cracks carry no share of tension.
+    const Principal pr = principal(effective);
+    Mat<2> s = compose(crack(pr.a, 1 - d), crack(pr.b, 1 - d), pr.direction);
+    double s_zz = crack(effective_zz, 1 - d);
+    // Friction bounds compressive states, with the cohesion the cracks leave;
+    // tension is the damage law's to soften (a cone there would cap the elastic
+    // strain the damage is read from).
+    double work = 0;
+    const bool compressive = s.trace() + s_zz < 0;
+    if (const double multiplier =
+            compressive ? drucker_prager_return(alpha_, (1 - d) * k0_, 0.0, g, bulk, s, s_zz, &work) : 0.0;
+        multiplier > 0) {
+      p.plastic_strain[i] += multiplier / std::sqrt(3.0);  // no dilation: sqrt(2/3 |dg/dsigma|^2) = 1/sqrt(3)
+      dissipated += p.volume[i] * work;
+      // Carry the return back to the undamaged stress (same principal axes).
+      const Principal back = principal(s);
+      const double open = d < 1 ? 1 / (1 - d) : 0.0;
+      effective = compose(crack(back.a, open), crack(back.b, open), back.direction);
+      effective_zz = crack(s_zz, open);
+    }
+    p.stress[i] = s;
+    p.stress_zz[i] = s_zz;
   }
   return dissipated;
 }

@@ -69,6 +69,12 @@ struct DruckerPragerFit {
   static std::pair<double, double> coefficients(Kind kind, double cohesion, double friction_angle);
 };
 
+// Return a trial stress to the cone f = alpha I1/3 + sqrt(J2) - k (or its apex)
+// with the potential's alpha_dilation; G and K the elastic moduli. Returns the
+// plastic multiplier and, if asked, the plastic work density [J/m^3].
+double drucker_prager_return(double alpha, double k, double alpha_dilation, double shear_modulus,
+                             double bulk_modulus, Mat<2>& stress, double& stress_zz, double* work_density);
+
 class DruckerPrager final : public Material {
  public:
   DruckerPrager(std::string name, Elasticity elasticity, double cohesion, double friction_angle,
@@ -85,6 +91,41 @@ class DruckerPrager final : public Material {
 
  private:
   double alpha_, k_, alpha_dilation_;
+};
+
+// The elastic-damage law of RFPA-type models (model-notes section 3, paper
+// eqs. 10-14), made to leave fragmented coal behind rather than nothing:
+//  - the undamaged (effective) stress sigma~ follows Jaumann-rate elasticity
+//    with E0; damage is read from its principal stresses and strains;
+//  - tensile damage once the largest principal stress reaches f_t:
+//    D = 1 - f_tr / (E0 eps_1) up to eps_1 = eta f_t / E0, then D = 1;
+//  - shear damage once Mohr-Coulomb (c, phi) is reached:
+//    D = 1 - f_cr / (E0 |eps_3|), f_cr the residual share of the UCS;
+//  - D never decreases. The stress acting is sigma~ with its tensile principal
+//    parts scaled by (1 - D) (open cracks carry no tension) and its compressive
+//    parts kept (closed cracks carry compression); compressive states are
+//    bounded by Drucker-Prager friction with cohesion (1 - D) c: fully damaged
+//    coal is cohesionless, tension-free granular material that still piles up
+//    and rubs.
+struct DamageParameters {
+  double cohesion;          // c [Pa]
+  double friction_angle;    // phi [rad]
+  double tensile_strength;  // f_t [Pa]
+  double residual_ratio;    // f_tr / f_t = f_cr / f_c
+  double ultimate_ratio;    // eta = eps_tu / eps_t0
+};
+
+class ElasticDamage final : public Material {
+ public:
+  ElasticDamage(std::string name, Elasticity elasticity, DamageParameters damage);
+  double update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const override;
+  // Damage of one particle, given its history value and effective stress.
+  double damage(double previous, const Mat<2>& effective, double effective_zz) const;
+  const DamageParameters& parameters() const { return parameters_; }
+
+ private:
+  DamageParameters parameters_;
+  double alpha_, k0_;  // Drucker-Prager friction cone (outer fit), intact cohesion
 };
 
 }  // namespace outburst::mpm

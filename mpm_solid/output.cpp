@@ -18,7 +18,7 @@ Output::Output(const std::filesystem::path& directory, const output::RunInfo& in
   if (!tracers_.empty()) {
     tracer_file_.open(directory / "tracers.csv", std::ios::trunc);
     tracer_file_ << "time_s,tracer,particle_id,x_m,y_m,vx_m_per_s,vy_m_per_s,speed_m_per_s,ux_m,uy_m,"
-                    "sigma_max_Pa,sigma_min_Pa,plastic_strain\n";
+                    "sigma_max_Pa,sigma_min_Pa,plastic_strain,damage\n";
   }
   series_.add_point_grid("particles");
   history_.open(directory / "mpm_history.csv", std::ios::trunc);
@@ -31,7 +31,7 @@ void Output::snapshot(const Solver& solver) {
   if (!initial_total_) initial_total_ = solver.energies().total();
   const auto& p = solver.particles();
   const std::size_t n = p.size();
-  std::vector<double> xyz, velocity, displacement, stress, s_max, s_min, material, id;
+  std::vector<double> xyz, velocity, displacement, stress, s_max, s_min, material, id, damage, plastic;
   xyz.reserve(3 * n);
   for (std::size_t i = 0; i < n; ++i) {
     xyz.insert(xyz.end(), {p.x[i].x(), p.x[i].y(), 0.0});
@@ -45,6 +45,8 @@ void Output::snapshot(const Solver& solver) {
     s_min.push_back(lo);
     material.push_back(p.material[i]);
     id.push_back(p.id[i]);
+    damage.push_back(p.damage[i]);
+    plastic.push_back(p.plastic_strain[i]);
   }
   output::Snapshot snap(solver.time());
   snap.set_points("particles", std::move(xyz));
@@ -53,6 +55,8 @@ void Output::snapshot(const Solver& solver) {
   snap.add("particles", {"stress", output::Center::node, 6, "Pa (tension positive)", std::move(stress)});
   snap.add("particles", {"sigma_max", output::Center::node, 1, "Pa", std::move(s_max)});
   snap.add("particles", {"sigma_min", output::Center::node, 1, "Pa", std::move(s_min)});
+  snap.add("particles", {"damage", output::Center::node, 1, "", std::move(damage)});
+  snap.add("particles", {"plastic_strain", output::Center::node, 1, "", std::move(plastic)});
   snap.add("particles", {"material", output::Center::node, 1, "", std::move(material)});
   snap.add("particles", {"id", output::Center::node, 1, "", std::move(id)});
   series_.write(snap);
@@ -73,9 +77,9 @@ void Output::history(const Solver& solver, const StepInfo& step) {
     if (found == tracers_.end()) continue;
     const Vec<2> u = p.x[i] - p.x0[i];
     const auto [hi, lo] = principal_extremes(p.stress[i], p.stress_zz[i]);
-    tracer_file_ << fmt::format("{:.10g},{},{},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.6g}\n",
+    tracer_file_ << fmt::format("{:.10g},{},{},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.6g},{:.6g}\n",
                                 solver.time(), found - tracers_.begin(), p.id[i], p.x[i].x(), p.x[i].y(), p.v[i].x(),
-                                p.v[i].y(), p.v[i].norm(), u.x(), u.y(), hi, lo, p.plastic_strain[i]);
+                                p.v[i].y(), p.v[i].norm(), u.x(), u.y(), hi, lo, p.plastic_strain[i], p.damage[i]);
   }
   tracer_file_.flush();
 }

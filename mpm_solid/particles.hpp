@@ -26,6 +26,9 @@ struct Particles {
   std::vector<Vec<Dim>> external_force;     // set by another program [N per m]
   std::vector<Vec<Dim>> surface_force;      // boundary tractions of the scene [N per m]
   std::vector<double> plastic_strain;       // equivalent plastic strain (accumulated)
+  std::vector<double> damage;               // D in [0, 1], irreversible (damage materials)
+  std::vector<Mat<Dim>> effective_stress;   // undamaged stress sigma~ (damage materials)
+  std::vector<double> effective_stress_zz;
   std::vector<std::int32_t> material;       // index into the scene's materials
   std::vector<std::int32_t> id;             // stable identity (tracers, output)
 
@@ -49,6 +52,9 @@ struct Particles {
     external_force.push_back(Vec<Dim>::Zero());
     surface_force.push_back(Vec<Dim>::Zero());
     plastic_strain.push_back(0.0);
+    damage.push_back(0.0);
+    effective_stress.push_back(initial_stress);
+    effective_stress_zz.push_back(initial_stress_zz);
     material.push_back(material_index);
     id.push_back(static_cast<std::int32_t>(id.size()));
   }
@@ -74,6 +80,9 @@ struct Particles {
         external_force[to] = external_force[from];
         surface_force[to] = surface_force[from];
         plastic_strain[to] = plastic_strain[from];
+        damage[to] = damage[from];
+        effective_stress[to] = effective_stress[from];
+        effective_stress_zz[to] = effective_stress_zz[from];
         material[to] = material[from];
         id[to] = id[from];
       }
@@ -99,6 +108,9 @@ struct Particles {
     external_force.resize(n);
     surface_force.resize(n);
     plastic_strain.resize(n);
+    damage.resize(n);
+    effective_stress.resize(n);
+    effective_stress_zz.resize(n);
     material.resize(n);
     id.resize(n);
   }

@@ -126,14 +126,32 @@ Setup read_setup(const scene::Table& s) {
     if (std::find(names.begin(), names.end(), name) != names.end())
       m.fail("name", fmt::format("material \"{}\" is defined twice", name));
     const std::string model = m.choice(
-        {"model", "\"elastic\" (Jaumann rate) or \"drucker_prager\" (perfectly plastic)", "elastic"},
-        {"elastic", "drucker_prager"});
+        {"model", "\"elastic\" (Jaumann rate), \"drucker_prager\" (perfectly plastic) or \"elastic_damage\" "
+                  "(brittle, leaving granular fragments)",
+         "elastic"},
+        {"elastic", "drucker_prager", "elastic_damage"});
     Elasticity e{};
     e.density = m.quantity({"density", "mass density", "", Range::positive()}, units::density);
     e.youngs_modulus = m.quantity({"youngs_modulus", "Young's modulus E", "", Range::positive()}, units::pressure);
     e.poisson_ratio = m.number({"poisson_ratio", "Poisson's ratio", "", Range{-1.0, 0.5, false, false}});
     if (model == "elastic") {
       setup.materials.push_back(std::make_unique<LinearElastic>(name, e));
+    } else if (model == "elastic_damage") {
+      DamageParameters d{};
+      d.cohesion = m.quantity({"cohesion", "Mohr-Coulomb cohesion c of the intact coal", "", Range::positive()},
+                              units::pressure);
+      d.friction_angle = m.quantity({"friction_angle", "Mohr-Coulomb friction angle (also of the fragments)", "",
+                                     Range{0.0, 1.5, true, false}},
+                                    units::angle);
+      d.tensile_strength = m.quantity({"tensile_strength", "tensile strength f_t", "", Range::positive()},
+                                      units::pressure);
+      d.residual_ratio = m.number({"residual_ratio", "residual strength / strength, in tension and compression "
+                                                     "(the paper gives none; 0.1 is common for RFPA models)",
+                                   "0.1", Range{0.0, 1.0, true, false}});
+      d.ultimate_ratio = m.number({"ultimate_strain_ratio", "eta = ultimate tensile strain / strain at f_t, beyond "
+                                                            "which D = 1 (the paper gives none; 5-10 is common)",
+                                   "5", Range::at_least(1)});
+      setup.materials.push_back(std::make_unique<ElasticDamage>(name, e, d));
     } else {
       const double c = m.quantity({"cohesion", "Mohr-Coulomb cohesion c", "", Range::non_negative()}, units::pressure);
       const double phi = m.quantity({"friction_angle", "Mohr-Coulomb friction angle", "",

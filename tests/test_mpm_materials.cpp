@@ -107,3 +107,69 @@ TEST_CASE("Drucker-Prager below the yield surface is elastic", "[mpm][material]"
   CHECK(a.stress[0] == b.stress[0]);
   CHECK(a.plastic_strain[0] == 0);
 }
+
+namespace {
+
+const DamageParameters coal_damage{1e6, 30 * deg, 0.2e6, 0.1, 5.0};
+
+}  // namespace
+
+TEST_CASE("elastic-damage: uniaxial-strain tension follows D = 1 - f_tr / (E0 eps)", "[mpm][material][damage]") {
+  ElasticDamage m("coal", coal, coal_damage);
+  auto p = one_particle();
+  Mat<2> l = Mat<2>::Zero();
+  l(0, 0) = 1.0;
+  const double eps = 4e-5;  // past f_t (at 1.6e-5) and below eta f_t / E0 (1.7e-4)
+  drive(m, p, l, 400, eps / 400);
+  const double p_modulus = coal.lame_lambda() + 2 * coal.shear_modulus();
+  // In uniaxial strain the largest principal strain is eps itself.
+  const double expected = 1 - 0.1 * 0.2e6 / (6e9 * eps);
+  CHECK(p.damage[0] == Approx(expected).epsilon(1e-9));
+  CHECK(p.stress[0](0, 0) == Approx((1 - expected) * p_modulus * eps).epsilon(1e-9));
+  CHECK(p.effective_stress[0](0, 0) == Approx(p_modulus * eps).epsilon(1e-9));
+}
+
+TEST_CASE("elastic-damage: broken coal carries no tension but carries compression", "[mpm][material][damage]") {
+  ElasticDamage m("coal", coal, coal_damage);
+  auto p = one_particle();
+  Mat<2> l = Mat<2>::Zero();
+  l(0, 0) = 1.0;
+  drive(m, p, l, 200, 2e-4 / 200);  // past eta eps_t0: fully damaged
+  CHECK(p.damage[0] == 1.0);
+  CHECK(p.stress[0].norm() == 0.0);
+  CHECK(p.stress_zz[0] == 0.0);
+  // Push it back into compression: the damage stays, the fragments bear the load.
+  l(0, 0) = -1.0;
+  drive(m, p, l, 300, 3e-4 / 300);
+  CHECK(p.damage[0] == 1.0);
+  const double p_modulus = coal.lame_lambda() + 2 * coal.shear_modulus();
+  CHECK(p.stress[0](0, 0) == Approx(-p_modulus * 1e-4).epsilon(1e-9));
+  CHECK(p.stress[0](1, 1) == Approx(-coal.lame_lambda() * 1e-4).epsilon(1e-9));
+}
+
+TEST_CASE("elastic-damage: damage never heals on unloading", "[mpm][material][damage]") {
+  ElasticDamage m("coal", coal, coal_damage);
+  auto p = one_particle();
+  Mat<2> l = Mat<2>::Zero();
+  l(0, 0) = 1.0;
+  drive(m, p, l, 100, 4e-5 / 100);
+  const double reached = p.damage[0];
+  REQUIRE(reached > 0);
+  l(0, 0) = -1.0;
+  drive(m, p, l, 100, 3e-5 / 100);
+  CHECK(p.damage[0] == reached);
+}
+
+TEST_CASE("elastic-damage: shear damage weakens toward the friction cone", "[mpm][material][damage]") {
+  ElasticDamage m("coal", coal, coal_damage);
+  auto p = one_particle();
+  Mat<2> l = Mat<2>::Zero();
+  l(0, 0) = -1.0;
+  l(1, 1) = 0.9;
+  drive(m, p, l, 2000, 2e-3 / 2000);
+  CHECK(p.damage[0] > 0.5);
+  // The stress acting lies inside the cone of the remaining cohesion.
+  DruckerPrager remaining("left", coal, (1 - p.damage[0]) * 1e6, 30 * deg, 0.0, DruckerPragerFit::Kind::outer);
+  CHECK(remaining.yield(p.stress[0], p.stress_zz[0]) <= 1e-6 * 1e6);
+  CHECK(p.plastic_strain[0] > 0);
+}
