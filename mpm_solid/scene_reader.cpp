@@ -87,6 +87,11 @@ Setup read_setup(const scene::Table& s) {
                                  Range::between(0, 1)});
   st.courant = s.number({"courant", "time step as a fraction of the CFL limit h / (c + |v|)", "0.3",
                          Range{0.0, 1.0, false, true}});
+  st.smooth_dilatation = s.choice({"locking_remedy",
+                                   "\"nodal_dilatation\": smooth the volumetric strain rate over the nodes "
+                                   "(against volumetric locking and pressure checkerboards), or \"none\"",
+                                   "none"},
+                                  {"nodal_dilatation", "none"}) == "nodal_dilatation";
   st.local_damping = s.number({"local_damping",
                                "Cundall local damping coefficient (quasi-static stages; 0: off)", "0",
                                Range::between(0, 1)});

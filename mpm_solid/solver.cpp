@@ -157,6 +157,40 @@ void Solver::gather_velocity_gradient() {
   }
 }
 
+template <class Shape>
+void Solver::smooth_dilatation() {
+  auto& p = particles_;
+  const int n = static_cast<int>(p.size());
+  // Scatter V tr(L) and V, reusing the mass buffers (mass_ is rebuilt next step).
+#pragma omp parallel num_threads(static_cast<int>(thread_mass_.size()))
+  {
+    auto& weighted = thread_vector_[omp_get_thread_num()];
+    Stencil2<Shape> s;
+#pragma omp for schedule(static)
+    for (int i = 0; i < n; ++i) {
+      s.compute(grid_, p.x[i], p.half_width[i]);
+      const Vec<2> value(p.volume[i] * p.velocity_gradient[i].trace(), p.volume[i]);
+      for (int k = 0; k < s.count; ++k) weighted[s.node[k]] += s.weight[k] * value;
+    }
+  }
+  reduce(thread_vector_, force_);  // force_ is free until scatter_forces
+#pragma omp parallel
+  {
+    Stencil2<Shape> s;
+#pragma omp for schedule(static)
+    for (int i = 0; i < n; ++i) {
+      s.compute(grid_, p.x[i], p.half_width[i]);
+      double smoothed = 0;
+      for (int k = 0; k < s.count; ++k) {
+        const Vec<2>& node = force_[s.node[k]];
+        if (node[1] > 0) smoothed += s.weight[k] * node[0] / node[1];
+      }
+      Mat<2>& l = p.velocity_gradient[i];
+      l.diagonal().array() += 0.5 * (smoothed - l.trace());
+    }
+  }
+}
+
 void Solver::update_stresses(double dt) {
   for (std::size_t m = 0; m < materials_.size(); ++m)
     dissipated_.plastic += materials_[m]->update_stress(particles_, members_[m], dt);
@@ -312,6 +346,7 @@ void Solver::step_kernel(double dt) {
   grid_velocities();
   if constexpr (S == Scheme::usf) {
     gather_velocity_gradient<Shape>();
+    if (settings_.smooth_dilatation) smooth_dilatation<Shape>();
     update_stresses(dt);
   }
   scatter_forces<Shape>();
@@ -326,6 +361,7 @@ void Solver::step_kernel(double dt) {
   if constexpr (S != Scheme::usf) {
     if constexpr (S == Scheme::usl) velocity_.swap(velocity_new_);
     gather_velocity_gradient<Shape>();
+    if (settings_.smooth_dilatation) smooth_dilatation<Shape>();
     update_stresses(dt);
   }
   const int n = static_cast<int>(particles_.size());

@@ -49,6 +49,11 @@ struct Settings {
   double local_damping = 0;
   // left, right, bottom, top of the physical domain
   std::array<Wall, 4> walls;
+  // Volumetric-locking remedy: replace each particle's dilatation rate tr(L) by
+  // its volume-weighted average mapped to the nodes and back (nodal dilatation
+  // smoothing), leaving the deviatoric rate alone. Near-incompressible
+  // elasticity (nu = 0.4 here) and plastic flow otherwise lock and checkerboard.
+  bool smooth_dilatation = false;
   // Nodes lighter than this fraction of the mean particle mass are treated as
   // empty (no velocity): they would turn a finite force into a huge one.
   double empty_node_mass_fraction = 1e-6;
@@ -125,6 +130,8 @@ class Solver {
   void scatter_forces();
   template <class Shape>
   void gather_velocity_gradient();
+  template <class Shape>
+  void smooth_dilatation();
   template <class Shape, bool Apic>
   void gather_motion(double dt);
   void grid_velocities();
