@@ -80,7 +80,11 @@ void apply_override(toml::table& root, const std::string& assignment) {
     std::string key(rest.substr(0, dot));
     std::optional<std::size_t> index;
     if (const auto open = key.find('['); open != std::string::npos && key.back() == ']') {
-      index = std::stoul(key.substr(open + 1, key.size() - open - 2));
+      const std::string digits = key.substr(open + 1, key.size() - open - 2);
+      if (digits.empty() || digits.find_first_not_of("0123456789") != std::string::npos)
+        throw Error(fmt::format("--set '{}': '{}' is not an index; write {}[0]", assignment, digits,
+                                key.substr(0, open)));
+      index = std::stoul(digits);
       key.resize(open);
     }
     if (dot == std::string_view::npos && !index) {

@@ -36,7 +36,9 @@ struct Wall {
 
 struct Settings {
   Scheme scheme = Scheme::usf;
-  ShapeKind shape = ShapeKind::bspline;
+  // GIMP by default: second order in every test, where quadratic B-splines
+  // drop to first order next to walls and free surfaces.
+  ShapeKind shape = ShapeKind::gimp;
   // Velocity transfer: FLIP/PIC blend (1: pure FLIP, 0: pure PIC), or APIC
   // (affine particle-in-cell: PIC plus a velocity gradient per particle, which
   // conserves angular momentum without FLIP's noise).

@@ -118,6 +118,8 @@ TEST_CASE("command-line overrides replace scene keys and are checked like them",
                     Catch::Contains("--set: key 'seepage.regions[0].initial_pressure': must be > 0"));
   CHECK_THROWS_WITH(read_seepage_scene(valid, {"seepage.regions[3].lambda=\"1 m2/(MPa2 d)\""}),
                     Catch::Contains("no table regions[3]"));
+  CHECK_THROWS_WITH(read_seepage_scene(valid, {"seepage.regions[x].lambda=\"1 m2/(MPa2 d)\""}),
+                    Catch::Contains("'x' is not an index"));
 }
 
 TEST_CASE("explain lists every key read, marking defaults", "[scene]") {
