@@ -77,9 +77,7 @@ Setup read_setup(const scene::Table& s) {
       {"scheme", "\"usf\" (update stress first, the paper's), \"usl\" or \"musl\"", "usf"}, {"usf", "usl", "musl"});
   st.scheme = scheme == "usf" ? Scheme::usf : scheme == "usl" ? Scheme::usl : Scheme::musl;
   const std::string shape =
-      s.choice({"shape", "grid shape functions: \"linear\", \"gimp\" or \"bspline\" (quadratic; first order "
-                         "next to walls and free surfaces so far)",
-                "gimp"},
+      s.choice({"shape", "grid shape functions: \"linear\", \"gimp\" or \"bspline\" (quadratic)", "bspline"},
                {"linear", "gimp", "bspline"});
   st.shape = shape == "linear" ? ShapeKind::linear : shape == "gimp" ? ShapeKind::gimp : ShapeKind::bspline;
   st.apic = s.choice({"transfer", "velocity transfer: \"flip\" (FLIP/PIC blend) or \"apic\" (affine PIC)", "flip"},

@@ -130,6 +130,7 @@ void Solver::scatter_mass_momentum() {
   }
   reduce(thread_mass_, mass_);
   reduce(thread_vector_, momentum_);
+  fold_ghosts(&mass_, momentum_);
 }
 
 void Solver::grid_velocities() {
@@ -221,6 +222,7 @@ void Solver::scatter_forces() {
     }
   }
   reduce(thread_vector_, force_);
+  fold_ghosts(nullptr, force_);
 }
 
 void Solver::grid_update(double dt) {
@@ -242,6 +244,35 @@ void Solver::grid_update(double dt) {
     velocity_new_[i] = mass_[i] > empty_node_mass_ ? Vec<2>(velocity_[i] + dt * force_[i] / mass_[i])
                                                    : Vec<2>::Zero();
   dissipated_.walls += apply_walls(velocity_new_);
+}
+
+// What particles scatter to ghost nodes beyond a fixed or roller wall belongs,
+// by symmetry, to their mirror images inside: an image particle beyond the wall
+// would give the inside node exactly what the real one gives the ghost node,
+// reflected. Without this the nodes next to a wall miss their images' share and
+// wide shape functions (B-splines reach 1.5 cells) lose an order of accuracy.
+void Solver::fold_ghosts(std::vector<double>* mass, std::vector<Vec<2>>& vectors) const {
+  const int g = Grid<2>::ghost;
+  for (int side = 0; side < 4; ++side) {
+    const Wall& wall = settings_.walls[side];
+    if (wall.type != Wall::Type::fixed && wall.type != Wall::Type::roller) continue;
+    const int axis = side / 2, t = 1 - axis;
+    const int outward = side % 2 == 0 ? -1 : 1;
+    const int wall_row = outward < 0 ? g : g + grid_.cells[axis];
+    const double tangential = wall.type == Wall::Type::fixed ? -1.0 : 1.0;
+    for (int depth = 1; depth <= g; ++depth) {
+      std::array<int, 2> ghost{}, mirror{};
+      ghost[axis] = wall_row + depth * outward;
+      mirror[axis] = wall_row - depth * outward;
+      for (int k = 0; k < grid_.nodes_along(t); ++k) {
+        ghost[t] = mirror[t] = k;
+        const std::size_t from = grid_.index(ghost), to = grid_.index(mirror);
+        if (mass) (*mass)[to] += (*mass)[from];
+        vectors[to][axis] -= vectors[from][axis];
+        vectors[to][t] += tangential * vectors[from][t];
+      }
+    }
+  }
 }
 
 // Walls sit on the physical domain's edges, on a row of nodes. The wall node
