@@ -67,6 +67,7 @@ Solver::Solver(Grid<2> grid, std::vector<std::unique_ptr<Material>> materials,
   for (double m : particles_.mass) total_mass += m;
   empty_node_mass_ = settings_.empty_node_mass_fraction * total_mass / static_cast<double>(particles_.size());
   rebuild_material_groups();
+  for (const auto& m : materials_) wave_speed_squared_.push_back(std::pow(m->elasticity().p_wave_speed(), 2));
 
   // One kernel per (shape, scheme), chosen here once.
   const auto with_transfer = [&]<class Shape, Scheme S>() -> void (Solver::*)(double) {
@@ -403,14 +404,28 @@ void Solver::step_kernel(double dt) {
 void Solver::remove_escaped(StepInfo& info) {
   auto& p = particles_;
   const int n = static_cast<int>(p.size());
-  long bad = 0, escaped = 0;
-#pragma omp parallel for schedule(static) reduction(+ : bad, escaped)
+  long bad = 0, escaped = 0, runaway = 0;
+#pragma omp parallel for schedule(static) reduction(+ : bad, escaped, runaway)
   for (int i = 0; i < n; ++i) {
     if (!p.x[i].allFinite() || !p.v[i].allFinite() || !p.stress[i].allFinite())
       ++bad;
     else if (!grid_.inside(p.x[i]))
       ++escaped;
+    else if (p.v[i].squaredNorm() > wave_speed_squared_[p.material[i]])
+      ++runaway;
   }
+  // Material outrunning its own P wave is beyond what an explicit step can carry:
+  // the energy is exploding. Stop before it turns into NaN.
+  if (runaway > 0 && bad == 0)
+    for (int i = 0; i < n; ++i) {
+      if (p.v[i].squaredNorm() <= wave_speed_squared_[p.material[i]]) continue;
+      throw SimulationError(fmt::format(
+          "mpm: step {} (t = {:.6g} s): the energy is exploding: particle {} (material \"{}\") has a velocity "
+          "of {:.3g} m/s, above its P-wave speed {:.3g} m/s; the time step may exceed the stable one, or a load "
+          "is out of range",
+          steps_ + 1, time_, p.id[i], materials_[p.material[i]]->name(), p.v[i].norm(),
+          std::sqrt(wave_speed_squared_[p.material[i]])));
+    }
   if (bad > 0)
     for (int i = 0; i < n; ++i) {
       if (p.x[i].allFinite() && p.v[i].allFinite() && p.stress[i].allFinite()) continue;

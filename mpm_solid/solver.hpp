@@ -94,7 +94,7 @@ class Solver {
   // Largest stable step: courant * h / max over particles of (c_p + |v_p|).
   double stable_time_step() const;
   // One explicit step; SimulationError (naming the step, particle and field)
-  // if a particle's state becomes non-finite.
+  // if a particle's state becomes non-finite or it outruns its P wave.
   StepInfo step(double dt);
 
   double time() const { return time_; }
@@ -151,6 +151,7 @@ class Solver {
   void (Solver::*kernel_)(double) = nullptr;
 
   std::vector<std::vector<int>> members_;  // particle indices per material
+  std::vector<double> wave_speed_squared_;  // per material, for the runaway check
   double empty_node_mass_ = 0;
 
   // Grid fields; per-thread copies of the scattered ones avoid locks.

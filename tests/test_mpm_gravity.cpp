@@ -149,3 +149,22 @@ TEST_CASE("nodal dilatation smoothing removes the pressure checkerboard of a nea
   CHECK(rms[1] < 0.5 * rms[0]);
   CHECK(rms[1] < 0.02);
 }
+
+TEST_CASE("a step far beyond the stable one stops the run naming step, particle and field", "[mpm][robust]") {
+  const Grid<2> gr = grid(4.0, 4.0, 0.25);
+  Settings s;
+  s.gravity = {0, -9.81};
+  s.walls[2] = {Wall::Type::fixed};
+  Solver solver(gr, elastic({1000, 1e7, 0.3}), block(gr, {1, 0}, {3, 2}, 1000, 2), s);
+  const double dt = 5 * solver.stable_time_step() / s.courant;  // five times the CFL limit
+  try {
+    for (int i = 0; i < 1000; ++i) solver.step(dt);
+    FAIL("the unstable run was not stopped");
+  } catch (const SimulationError& e) {
+    const std::string message = e.what();
+    INFO(message);
+    CHECK_THAT(message, Catch::Contains("mpm: step ") && Catch::Contains("particle ") &&
+                            (Catch::Contains("velocity") || Catch::Contains("non-finite")));
+    std::printf("\nunstable run stopped: %s\n", message.c_str());
+  }
+}
