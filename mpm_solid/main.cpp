@@ -17,8 +17,10 @@ int run(const RunOptions& options, scene::Document& doc) {
   const SceneHeader header = read_scene_header(root);
   require_solvers(root, header, {"mpm"}, "mpm-solid");
   mpm::Setup setup = mpm::read_setup(*root.table("mpm", "the material point solver", true));
-  if (!finish_reading(options, doc)) return 0;
+  doc.reject_unused();
 
+  // The particles exist now: a fixed step can be checked against their CFL limit
+  // (before --check returns, so it catches an unstable step too).
   mpm::Solver solver(setup.grid, std::move(setup.materials), std::move(setup.particles), setup.settings);
   const double stable = solver.stable_time_step();
   if (setup.fixed_time_step && *setup.fixed_time_step > stable / setup.settings.courant)
@@ -26,6 +28,7 @@ int run(const RunOptions& options, scene::Document& doc) {
         "{}: key 'mpm.time_step': {:.3g} s exceeds the stability limit h / (c + |v|) = {:.3g} s of this scene; "
         "use a smaller step or drop the key to let the CFL condition choose",
         doc.file().string(), *setup.fixed_time_step, stable / setup.settings.courant));
+  if (!finish_reading(options, doc)) return 0;
   spdlog::info("{}: {} particles, {} x {} cells of {:g} m, stable step {:.3g} s", header.title,
                solver.particles().size(), setup.grid.cells[0], setup.grid.cells[1], setup.grid.h, stable);
 
