@@ -163,7 +163,8 @@ template <class Shape>
 void Solver::smooth_dilatation() {
   auto& p = particles_;
   const int n = static_cast<int>(p.size());
-  // Scatter V tr(L) and V, reusing the mass buffers (mass_ is rebuilt next step).
+  // Scatter V tr(L) and V into the per-thread vector buffers, reduced into
+  // force_, which is free until scatter_forces rebuilds it.
 #pragma omp parallel num_threads(static_cast<int>(thread_mass_.size()))
   {
     auto& weighted = thread_vector_[omp_get_thread_num()];
@@ -175,7 +176,7 @@ void Solver::smooth_dilatation() {
       for (int k = 0; k < s.count; ++k) weighted[s.node[k]] += s.weight[k] * value;
     }
   }
-  reduce(thread_vector_, force_);  // force_ is free until scatter_forces
+  reduce(thread_vector_, force_);
 #pragma omp parallel
   {
     Stencil2<Shape> s;
@@ -488,10 +489,5 @@ Energies Solver::energies() const {
   return e;
 }
 
-double Solver::kinetic_energy() const {
-  double e = 0;
-  for (std::size_t i = 0; i < particles_.size(); ++i) e += 0.5 * particles_.mass[i] * particles_.v[i].squaredNorm();
-  return e;
-}
 
 }  // namespace outburst::mpm

@@ -120,7 +120,6 @@ class Solver {
   State save_state() const { return {time_, steps_, removed_, particles_, dissipated_}; }
   void restore_state(const State& s);
 
-  double kinetic_energy() const;
   Energies energies() const;
 
  private:

@@ -147,7 +147,7 @@ void Solver::setup_system() {
   // systems are ordered by nested dissection: a slower analysis, done once, for
   // a factorisation repeated every Newton iteration.
   blas::set_threads_for(static_cast<long>(n));
-  const bool supernodal = n >= supernodal_threshold;
+  const bool supernodal = this->supernodal();
   factor_.setMode(supernodal ? Eigen::CholmodSupernodalLLt : Eigen::CholmodSimplicialLLt);
   if (supernodal) {
     factor_.cholmod().nmethods = 1;
@@ -423,6 +423,8 @@ StepReport Solver::advance(double dt) {
   }
   return report;
 }
+
+bool Solver::supernodal() const { return mesh_.num_nodes() >= supernodal_threshold; }
 
 std::optional<double> Solver::pressure_at(const Eigen::Vector2d& x) const {
   const auto hit = locator_.locate(x);

@@ -115,6 +115,8 @@ class Solver {
   const Balance& balance() const { return balance_; }
   const Timings& timings() const { return timings_; }
 
+  // Whether CHOLMOD runs supernodal (large systems) or simplicial.
+  bool supernodal() const;
   // The current Jacobian (for benchmarks that time a bare factorisation of it).
   const Eigen::SparseMatrix<double>& jacobian() const { return jacobian_; }
 

@@ -83,7 +83,7 @@ int main(int argc, char** argv) {
     for (int a = 0; a < assemblies; ++a) solver.set_conductivity(std::vector<double>(solver.mesh().num_cells(), 0.1 + 1e-3 * a));
     const double assembly = seconds_since(start) / assemblies;
 
-    const bool supernodal = unknowns >= 100000;
+    const bool supernodal = solver.supernodal();
     const double bare = bare_factor_and_solve(solver.jacobian(), supernodal ? Eigen::CholmodSupernodalLLt
                                                                             : Eigen::CholmodSimplicialLLt, 3);
     // Both CHOLMOD modes on the same matrix, to place the switch between them.
