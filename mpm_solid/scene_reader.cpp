@@ -13,15 +13,45 @@ using scene::Range;
 
 namespace {
 
+Wall::Type wall_type(const std::string& type) {
+  if (type == "fixed") return Wall::Type::fixed;
+  if (type == "roller") return Wall::Type::roller;
+  if (type == "friction") return Wall::Type::friction;
+  return Wall::Type::open;
+}
+
 Wall read_wall(const scene::Table& t, std::string_view side, double friction) {
   const std::string type = t.choice({side, "\"open\" (particles may leave), \"fixed\", \"roller\" (no normal "
                                            "motion) or \"friction\" (Coulomb, unilateral)",
                                      "open"},
                                     {"open", "fixed", "roller", "friction"});
-  if (type == "fixed") return {Wall::Type::fixed, 0};
-  if (type == "roller") return {Wall::Type::roller, 0};
-  if (type == "friction") return {Wall::Type::friction, friction};
-  return {Wall::Type::open, 0};
+  return {wall_type(type), type == "friction" ? friction : 0.0};
+}
+
+void read_obstacles(const scene::Table& s, Settings& st, const Grid<2>& grid) {
+  for (const auto& o : s.table_array("obstacles", "rigid fixed rectangles inside the grid (roof and floor rock, "
+                                                  "supports); faces best on grid lines")) {
+    const auto lo = o.quantity_vector({"box_min", "lower-left corner"}, units::length, 2);
+    const auto hi = o.quantity_vector({"box_max", "upper-right corner"}, units::length, 2);
+    const Vec<2> lov(lo[0], lo[1]), hiv(hi[0], hi[1]);
+    if (!(hiv.array() > lov.array()).all()) o.fail("box_max", "must lie above and right of box_min");
+    if ((hiv.array() <= grid.lower.array()).any() || (lov.array() >= grid.upper.array()).any())
+      o.fail("box_min", "the obstacle lies outside the grid");
+    const std::string type = o.choice({"contact", "\"friction\" (Coulomb, material may separate), \"roller\" "
+                                                  "(bonded normal to the face, free to slide) or \"fixed\" (bonded)",
+                                       "friction"},
+                                      {"fixed", "roller", "friction"});
+    const double mu = o.number({"friction_coefficient", "Coulomb coefficient of a \"friction\" contact", "0",
+                                Range::non_negative()});
+    st.obstacles.push_back({lov, hiv, {wall_type(type), type == "friction" ? mu : 0.0}});
+  }
+}
+
+// Index of the obstacle strictly containing x, if any.
+std::optional<std::size_t> obstacle_at(const std::vector<Obstacle>& obstacles, const Vec<2>& x) {
+  for (std::size_t k = 0; k < obstacles.size(); ++k)
+    if ((x.array() > obstacles[k].lower.array()).all() && (x.array() < obstacles[k].upper.array()).all()) return k;
+  return std::nullopt;
 }
 
 // Even-odd rule point-in-polygon test.
@@ -125,6 +155,8 @@ Setup read_setup(const scene::Table& s) {
     for (int w = 0; w < 4; ++w) st.walls[w] = read_wall(*walls, sides[w], mu);
   }
 
+  read_obstacles(s, st, gr);
+
   std::vector<std::string> names;
   for (const auto& m : s.table_array("materials", "constitutive models, referred to by name")) {
     const std::string name = m.string({"name", "material name"});
@@ -210,8 +242,12 @@ Setup read_setup(const scene::Table& s) {
       if (!((hiv.array() > lov.array()).all())) b.fail("box_max", "must lie above and right of box_min");
       fill_cells(gr, ppc, lov, hiv, [](const Vec<2>&) { return true; }, points);
     }
-    if (points.empty())
-      b.fail(b.has("polygon") ? "polygon" : "box_min", "the body holds no particle positions of the grid");
+    const char* shape_key = b.has("polygon") ? "polygon" : "box_min";
+    if (points.empty()) b.fail(shape_key, "the body holds no particle positions of the grid");
+    for (const auto& x : points)
+      if (const auto k = obstacle_at(st.obstacles, x))
+        b.fail(shape_key, fmt::format("the body overlaps obstacle {} (mpm.obstacles[{}]) at ({:g}, {:g}) m", *k + 1,
+                                      *k, x.x(), x.y()));
     const auto v0 = b.quantity_vector({"initial_velocity", "velocity at t = 0", "0 m/s, 0 m/s"}, units::velocity, 2);
     const auto s0 = b.quantity_vector({"initial_stress", "in-situ stress xx, yy, xy (tension positive)",
                                        "0 Pa, 0 Pa, 0 Pa"},

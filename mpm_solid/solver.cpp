@@ -44,6 +44,29 @@ void reduce(std::vector<std::vector<Vec<2>>>& parts, std::vector<Vec<2>>& total)
   }
 }
 
+// A wall condition at one node; n is the unit normal pointing into the wall.
+// Friction walls act only on nodes moving into them: the normal velocity is
+// removed and the tangential one reduced by mu times that change. Returns the
+// work done by friction (fixed and roller walls do none: the wall does not move).
+double constrain(Vec<2>& v, const Vec<2>& n, const Wall& wall, double mass) {
+  const double vn = v.dot(n);
+  switch (wall.type) {
+    case Wall::Type::fixed: v.setZero(); return 0;
+    case Wall::Type::roller: v -= vn * n; return 0;
+    case Wall::Type::friction: {
+      if (vn <= 0) return 0;  // separating
+      const Vec<2> vt = v - vn * n;
+      const double slip = vt.norm();
+      const double reduced = std::max(slip - wall.friction * vn, 0.0);
+      v = slip > 0 ? Vec<2>(vt * (reduced / slip)) : Vec<2>::Zero();
+      // Work of the friction impulse m (|v_t| - reduced) against the sliding.
+      return mass * (slip - reduced) * reduced;
+    }
+    case Wall::Type::open: return 0;
+  }
+  return 0;
+}
+
 }  // namespace
 
 Solver::Solver(Grid<2> grid, std::vector<std::unique_ptr<Material>> materials,
@@ -67,6 +90,7 @@ Solver::Solver(Grid<2> grid, std::vector<std::unique_ptr<Material>> materials,
   for (double m : particles_.mass) total_mass += m;
   empty_node_mass_ = settings_.empty_node_mass_fraction * total_mass / static_cast<double>(particles_.size());
   rebuild_material_groups();
+  find_obstacle_nodes();
   for (const auto& m : materials_) wave_speed_squared_.push_back(std::pow(m->elasticity().p_wave_speed(), 2));
 
   // One kernel per (shape, scheme), chosen here once.
@@ -85,6 +109,31 @@ Solver::Solver(Grid<2> grid, std::vector<std::unique_ptr<Material>> materials,
     case ShapeKind::linear: kernel_ = pick.template operator()<Linear>(); break;
     case ShapeKind::gimp: kernel_ = pick.template operator()<Gimp>(); break;
     case ShapeKind::bspline: kernel_ = pick.template operator()<Bspline>(); break;
+  }
+}
+
+void Solver::find_obstacle_nodes() {
+  const double tolerance = 1e-9 * grid_.h;
+  for (std::size_t k = 0; k < settings_.obstacles.size(); ++k) {
+    const Obstacle& o = settings_.obstacles[k];
+    if (!(o.upper.array() > o.lower.array()).all())
+      throw std::invalid_argument("an obstacle's upper corner must lie above and right of its lower corner");
+    for (std::size_t i = 0; i < node_ij_.size(); ++i) {
+      const Vec<2> x = grid_.node_position(node_ij_[i]);
+      if ((x.array() < o.lower.array() - tolerance).any() || (x.array() > o.upper.array() + tolerance).any())
+        continue;
+      // Distances to the left, right, bottom and top faces; the nearest sets
+      // the normal, and a corner (two nearest) takes their diagonal.
+      const std::array<double, 4> distance{x.x() - o.lower.x(), o.upper.x() - x.x(), x.y() - o.lower.y(),
+                                           o.upper.y() - x.y()};
+      const std::array<Vec<2>, 4> inward{Vec<2>(1, 0), Vec<2>(-1, 0), Vec<2>(0, 1), Vec<2>(0, -1)};
+      const double nearest = *std::min_element(distance.begin(), distance.end());
+      Vec<2> n = Vec<2>::Zero();
+      for (int f = 0; f < 4; ++f)
+        if (distance[f] <= nearest + tolerance) n += inward[f];
+      if (n.squaredNorm() == 0) continue;  // the centre of a square obstacle: no material reaches it
+      obstacle_nodes_.push_back({i, n.normalized(), k});
+    }
   }
 }
 
@@ -281,10 +330,8 @@ void Solver::fold_ghosts(std::vector<double>* mass, std::vector<Vec<2>>& vectors
 // takes the condition; ghost nodes beyond it mirror the node inside, with the
 // constrained components reflected oddly, so the interpolated velocity meets the
 // condition at the wall itself and not half a cell inside (which costs wide
-// shape functions a whole order of accuracy). Friction walls act only on nodes
-// moving into them: the normal velocity is removed and the tangential one
-// reduced by mu times that change. Returns the work done by friction (fixed and
-// roller walls do none: the wall does not move).
+// shape functions a whole order of accuracy). Obstacles follow. Returns the
+// work done by friction.
 double Solver::apply_walls(std::vector<Vec<2>>& velocity) const {
   const int g = Grid<2>::ghost;
   const std::size_t n = velocity.size();
@@ -298,6 +345,8 @@ double Solver::apply_walls(std::vector<Vec<2>>& velocity) const {
       const int axis = side / 2, t = 1 - axis;
       const int outward = side % 2 == 0 ? -1 : 1;  // wall normal, out of the domain
       const int wall_row = outward < 0 ? g : g + grid_.cells[axis];
+      Vec<2> normal = Vec<2>::Zero();
+      normal[axis] = outward;
 #pragma omp parallel for schedule(static) reduction(+ : friction_work)
       for (std::size_t i = 0; i < n; ++i) {
         const auto& ij = node_ij_[i];
@@ -311,24 +360,12 @@ double Solver::apply_walls(std::vector<Vec<2>>& velocity) const {
           v[t] = wall.type == Wall::Type::fixed ? -m[t] : m[t];
           continue;
         }
-        switch (wall.type) {
-          case Wall::Type::fixed: v.setZero(); break;
-          case Wall::Type::roller: v[axis] = 0; break;
-          case Wall::Type::friction: {
-            const double vn = v[axis] * outward;
-            if (vn <= 0) break;  // separating
-            v[axis] = 0;
-            const double reduced = std::max(std::abs(v[t]) - wall.friction * vn, 0.0);
-            // Work of the friction impulse m (|v_t| - reduced) against the sliding.
-            friction_work += mass_[i] * (std::abs(v[t]) - reduced) * reduced;
-            v[t] = std::copysign(reduced, v[t]);
-            break;
-          }
-          case Wall::Type::open: break;
-        }
+        friction_work += constrain(v, normal, wall, mass_[i]);
       }
     }
   }
+  for (const auto& o : obstacle_nodes_)
+    friction_work += constrain(velocity[o.node], o.normal, settings_.obstacles[o.obstacle].contact, mass_[o.node]);
   return friction_work;
 }
 

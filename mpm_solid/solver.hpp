@@ -34,6 +34,15 @@ struct Wall {
   double friction = 0;  // Coulomb coefficient (friction walls)
 };
 
+// A rigid, fixed rectangle inside the grid (the tunnel's roof and floor rock, a
+// support): grid nodes inside it or on its edges take its contact condition,
+// with the normal of the nearest face. Faces on grid lines act exactly there;
+// others act up to a cell inside the obstacle.
+struct Obstacle {
+  Vec<2> lower, upper;
+  Wall contact{Wall::Type::friction, 0};
+};
+
 struct Settings {
   Scheme scheme = Scheme::usf;
   // Quadratic B-splines by default: C1 gradients (no cell-crossing noise when
@@ -51,6 +60,7 @@ struct Settings {
   double local_damping = 0;
   // left, right, bottom, top of the physical domain
   std::array<Wall, 4> walls;
+  std::vector<Obstacle> obstacles;
   // Volumetric-locking remedy: replace each particle's dilatation rate tr(L) by
   // its volume-weighted average mapped to the nodes and back (nodal dilatation
   // smoothing), leaving the deviatoric rate alone. Near-incompressible
@@ -138,6 +148,7 @@ class Solver {
   void grid_velocities();
   void grid_update(double dt);
   double apply_walls(std::vector<Vec<2>>& velocity) const;
+  void find_obstacle_nodes();
   void fold_ghosts(std::vector<double>* mass, std::vector<Vec<2>>& vectors) const;
   void update_stresses(double dt);
   void remove_escaped(StepInfo& info);
@@ -160,6 +171,12 @@ class Solver {
   std::vector<std::vector<Vec<2>>> thread_vector_;
   std::vector<std::array<int, 2>> node_ij_;  // grid coordinates of each node
   std::vector<Vec<2>> displacement_;         // of each particle over the step
+  struct ObstacleNode {
+    std::size_t node;
+    Vec<2> normal;  // unit, pointing into the obstacle
+    std::size_t obstacle;
+  };
+  std::vector<ObstacleNode> obstacle_nodes_;
 
   double time_ = 0;
   long steps_ = 0;

@@ -19,7 +19,7 @@ TEST_CASE("two elastic disks collide with the energy balanced", "[mpm][disks]") 
   const Grid<2> gr = grid(1.0, 1.0, h);
   const double radius = 0.2, v0 = 0.1, rho = 1000;
   std::vector<Vec<2>> points;
-  for (const Vec<2> centre : {Vec<2>(0.25, 0.25), Vec<2>(0.75, 0.75)})
+  for (const Vec<2>& centre : {Vec<2>(0.25, 0.25), Vec<2>(0.75, 0.75)})
     fill_cells(gr, 2, centre.array() - radius, centre.array() + radius,
                [&](const Vec<2>& x) { return (x - centre).norm() <= radius; }, points);
   Particles<2> p;
