@@ -1,5 +1,6 @@
-// mpm-benchmark: particle-steps per second of the explicit step, for elastic
-// and Drucker-Prager material, linear and B-spline shapes, 1 and 2 threads.
+// mpm-benchmark: particle-steps per second of the explicit step, for elastic,
+// Drucker-Prager and elastic-damage material, linear and B-spline shapes, 1 and
+// 2 threads.
 //
 // Problem: a square elastic (or plastic) block with 4 particles per cell
 // released under gravity onto a fixed floor, so that every step does real
@@ -20,7 +21,12 @@ using namespace outburst::mpm;
 
 namespace {
 
-double particle_steps_per_second(long particles, ShapeKind shape, bool plastic, int threads) {
+enum class Model { elastic, drucker_prager, elastic_damage };
+const char* model_name(Model m) {
+  return m == Model::elastic ? "elastic" : m == Model::drucker_prager ? "drucker_prager" : "elastic_damage";
+}
+
+double particle_steps_per_second(long particles, ShapeKind shape, Model model, int threads) {
   omp_set_num_threads(threads);
   const int per_cell = 2;
   const int side = static_cast<int>(std::lround(std::sqrt(static_cast<double>(particles)) / per_cell));
@@ -37,10 +43,16 @@ double particle_steps_per_second(long particles, ShapeKind shape, bool plastic, 
   for (const auto& x : points) p.add(x, Vec<2>::Zero(), 1600 * volume, volume, 0.5 / per_cell, Mat<2>::Zero(), 0, 0);
   const Elasticity e{1600, 6e7, 0.3};
   std::vector<std::unique_ptr<Material>> materials;
-  if (plastic)
-    materials.push_back(std::make_unique<DruckerPrager>("coal", e, 1e4, 0.5, 0.0, DruckerPragerFit::Kind::outer));
-  else
-    materials.push_back(std::make_unique<LinearElastic>("coal", e));
+  switch (model) {
+    case Model::elastic: materials.push_back(std::make_unique<LinearElastic>("coal", e)); break;
+    case Model::drucker_prager:
+      materials.push_back(std::make_unique<DruckerPrager>("coal", e, 1e4, 0.5, 0.0, DruckerPragerFit::Kind::outer));
+      break;
+    case Model::elastic_damage:
+      // Weak enough that the block damages as it lands.
+      materials.push_back(std::make_unique<ElasticDamage>("coal", e, DamageParameters{2e4, 0.5, 2e3, 0.1, 5}));
+      break;
+  }
   Settings s;
   s.shape = shape;
   s.gravity = {0, -9.81};
@@ -62,18 +74,26 @@ double particle_steps_per_second(long particles, ShapeKind shape, bool plastic, 
 
 int main(int argc, char** argv) {
   std::vector<long> sizes;
-  for (int i = 1; i < argc; ++i) sizes.push_back(std::atol(argv[i]));
+  for (int i = 1; i < argc; ++i) {
+    char* end = nullptr;
+    const double n = std::strtod(argv[i], &end);
+    if (*end != '\0' || n < 100) {
+      std::fprintf(stderr, "usage: mpm-benchmark [particles ...]   (numbers of at least 100; default 1e4 1e5 1e6)\n");
+      return 2;
+    }
+    sizes.push_back(std::lround(n));
+  }
   if (sizes.empty()) sizes = {10000, 100000, 1000000};
   const int cores = omp_get_max_threads();
   std::printf("particle-steps per second (2D plane strain, 4 particles per cell), %d cores\n\n", cores);
   std::printf("%9s %-9s %-15s %12s %12s %9s\n", "particles", "shape", "material", "1 thread", "2 threads", "speed-up");
   for (long n : sizes)
     for (ShapeKind shape : {ShapeKind::linear, ShapeKind::bspline})
-      for (bool plastic : {false, true}) {
-        const double one = particle_steps_per_second(n, shape, plastic, 1);
-        const double two = particle_steps_per_second(n, shape, plastic, std::min(2, cores));
+      for (Model model : {Model::elastic, Model::drucker_prager, Model::elastic_damage}) {
+        const double one = particle_steps_per_second(n, shape, model, 1);
+        const double two = particle_steps_per_second(n, shape, model, std::min(2, cores));
         std::printf("%9ld %-9s %-15s %12.3e %12.3e %9.2f\n", n, shape == ShapeKind::linear ? "linear" : "bspline",
-                    plastic ? "drucker_prager" : "elastic", one, two, two / one);
+                    model_name(model), one, two, two / one);
         std::fflush(stdout);
       }
   return 0;

@@ -1,0 +1,108 @@
+#pragma once
+// Acceleration of the fixed-point iteration of an implicit coupling window.
+//
+// A window's sub-iterations solve y = H(y), with y the data the second
+// participant sends the first (stacked fields) and H one pass through both
+// solvers. Each iteration k gives the input y_k, the output x_k = H(y_k) and
+// the residual r_k = x_k - y_k; an acceleration proposes y_(k+1).
+//
+//   constant:  y + omega r
+//   Aitken:    y + omega_k r, omega_k = -omega_(k-1) r_(k-1).(r_k - r_(k-1)) / |r_k - r_(k-1)|^2
+//   IQN-ILS:   x_k + W c, with c minimising |V c + r_k| (Degroote et al. 2009),
+//              V and W the differences of residuals and outputs between
+//              iterations, kept over a few past windows.
+//
+// Fields differ by orders of magnitude (pressure gradients against stresses
+// and volume fractions), so every inner product runs on preconditioned data:
+// each field is divided by the norm of its residual at the window's first
+// iteration (a per-window scaling; V and W are kept unscaled).
+
+#include <cstddef>
+#include <deque>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace outburst::coupling {
+
+// Where each field sits in the stacked vector.
+struct FieldSlice {
+  std::string name;
+  std::size_t offset = 0, size = 0;
+};
+
+struct AccelerationSettings {
+  enum class Kind { constant, aitken, iqn_ils };
+  Kind kind = Kind::iqn_ils;
+  // constant: the factor; Aitken and IQN-ILS: the factor of each window's first
+  // iteration (IQN-ILS only while it has no columns yet).
+  double relaxation = 0.5;
+  // IQN-ILS: past windows whose columns are reused, the most columns kept, and
+  // the filter dropping a column whose part orthogonal to the newer ones is
+  // below this fraction of its length (QR2 filter).
+  int reuse_windows = 8;
+  int max_columns = 100;
+  double filter = 1e-2;
+};
+
+class Acceleration {
+ public:
+  virtual ~Acceleration() = default;
+  // A new window; the slices describe the stacked vector of every call.
+  virtual void start_window(const std::vector<FieldSlice>& fields);
+  // The next input from this iteration's input y and output x = H(y).
+  virtual Eigen::VectorXd next(const Eigen::VectorXd& y, const Eigen::VectorXd& x) = 0;
+  // The window ended; converged windows feed reuse.
+  virtual void end_window(bool /*converged*/) {}
+
+ protected:
+  // Per-entry weights of the preconditioner, set at a window's first iteration.
+  void scale_from(const Eigen::VectorXd& residual, const Eigen::VectorXd& output);
+  std::vector<FieldSlice> fields_;
+  Eigen::VectorXd weight_;
+  int iteration_ = 0;  // within the window, counted by next()
+};
+
+std::unique_ptr<Acceleration> make_acceleration(const AccelerationSettings& settings);
+
+class ConstantRelaxation final : public Acceleration {
+ public:
+  explicit ConstantRelaxation(double omega) : omega_(omega) {}
+  Eigen::VectorXd next(const Eigen::VectorXd& y, const Eigen::VectorXd& x) override;
+
+ private:
+  double omega_;
+};
+
+class Aitken final : public Acceleration {
+ public:
+  explicit Aitken(double initial) : initial_(initial) {}
+  void start_window(const std::vector<FieldSlice>& fields) override;
+  Eigen::VectorXd next(const Eigen::VectorXd& y, const Eigen::VectorXd& x) override;
+
+ private:
+  double initial_, omega_ = 0;
+  Eigen::VectorXd previous_residual_;
+};
+
+class IqnIls final : public Acceleration {
+ public:
+  explicit IqnIls(const AccelerationSettings& settings) : settings_(settings) {}
+  void start_window(const std::vector<FieldSlice>& fields) override;
+  Eigen::VectorXd next(const Eigen::VectorXd& y, const Eigen::VectorXd& x) override;
+  void end_window(bool converged) override;
+  // Columns used by the last least-squares solve (after filtering).
+  int columns_used() const { return columns_used_; }
+
+ private:
+  AccelerationSettings settings_;
+  // Columns of this window, newest first, and of past windows.
+  std::deque<Eigen::VectorXd> v_, w_;
+  std::deque<std::deque<Eigen::VectorXd>> past_v_, past_w_;
+  Eigen::VectorXd previous_residual_, previous_output_;
+  int columns_used_ = 0;
+};
+
+}  // namespace outburst::coupling
