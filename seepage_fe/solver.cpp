@@ -131,14 +131,8 @@ void Solver::setup_system() {
       for (int node : edge)
         if (fixed_by_[node] < 0) fixed_by_[node] = static_cast<int>(k);
   }
-  for (Eigen::Index col = 0; col < stiffness_.outerSize(); ++col)
-    for (int k = stiffness_.outerIndexPtr()[col]; k < stiffness_.outerIndexPtr()[col + 1]; ++k) {
-      const int row = stiffness_.innerIndexPtr()[k];
-      if (row == col && fixed_by_[row] >= 0)
-        dirichlet_diagonal_.push_back(k);
-      else if (row != col && (fixed_by_[row] >= 0 || fixed_by_[col] >= 0))
-        dirichlet_zero_.push_back(k);
-    }
+  boundary_fixed_by_ = fixed_by_;
+  find_dirichlet_entries();
 
   jacobian_ = stiffness_;
   assemble_conductivity();
@@ -157,6 +151,40 @@ void Solver::setup_system() {
   const std::size_t size = n;
   for (auto* v : {&trial_, &history_, &load_, &r_, &delta_, &candidate_})
     v->setZero(static_cast<Eigen::Index>(size));
+}
+
+void Solver::find_dirichlet_entries() {
+  dirichlet_diagonal_.clear();
+  dirichlet_zero_.clear();
+  for (Eigen::Index col = 0; col < stiffness_.outerSize(); ++col)
+    for (int k = stiffness_.outerIndexPtr()[col]; k < stiffness_.outerIndexPtr()[col + 1]; ++k) {
+      const int row = stiffness_.innerIndexPtr()[k];
+      if (row == col && fixed_by_[row] >= 0)
+        dirichlet_diagonal_.push_back(k);
+      else if (row != col && (fixed_by_[row] >= 0 || fixed_by_[col] >= 0))
+        dirichlet_zero_.push_back(k);
+    }
+}
+
+// Open space is one more pressure condition, index K = number of the scene's
+// conditions, with its own balance slot added on first use.
+void Solver::set_open_nodes(const std::vector<char>& open, double pressure) {
+  if (open.size() != mesh_.num_nodes())
+    throw std::invalid_argument(fmt::format("set_open_nodes: {} flags for {} nodes", open.size(), mesh_.num_nodes()));
+  if (model_.law == Law::gas && !(pressure > 0))
+    throw std::invalid_argument(fmt::format("set_open_nodes: open pressure {} Pa; the gas law needs p > 0", pressure));
+  const int open_condition = static_cast<int>(model_.boundary_conditions.size());
+  if (static_cast<int>(pressure_bc_slot_.size()) == open_condition) {
+    pressure_bc_slot_.push_back(static_cast<int>(balance_.pressure_boundaries.size()));
+    balance_.pressure_boundaries.push_back("open space");
+    balance_.inflow_through_pressure.push_back(0.0);
+    last_inflow_pressure_.push_back(0.0);
+  }
+  open_pressure_ = pressure;
+  for (std::size_t i = 0; i < open.size(); ++i)
+    fixed_by_[i] = boundary_fixed_by_[i] < 0 && open[i] ? open_condition : boundary_fixed_by_[i];
+  find_dirichlet_entries();
+  ++conductivity_version_;  // the Jacobian's rows changed: refactorise
 }
 
 void Solver::assemble_conductivity() {
@@ -203,8 +231,10 @@ void Solver::set_initial_pressure(const std::vector<double>& nodal_p) {
 void Solver::set_boundary_values(double t, Eigen::VectorXd& u) const {
   for (std::size_t i = 0; i < fixed_by_.size(); ++i)
     if (fixed_by_[i] >= 0)
-      u[static_cast<Eigen::Index>(i)] =
-          unknown_from_pressure(model_.law, model_.boundary_conditions[fixed_by_[i]].value(t));
+      u[static_cast<Eigen::Index>(i)] = unknown_from_pressure(
+          model_.law, static_cast<std::size_t>(fixed_by_[i]) < model_.boundary_conditions.size()
+                          ? model_.boundary_conditions[fixed_by_[i]].value(t)
+                          : open_pressure_);
 }
 
 void Solver::load_vector(double t, Eigen::VectorXd& f) const {
@@ -470,8 +500,8 @@ std::vector<Eigen::Vector2d> Solver::cell_flux() const {
 }
 
 Solver::State Solver::save_state() const {
-  return {time_,         steps_,          u_,       u_previous_,           dt_previous_,
-          has_previous_, conductivity_,   balance_, last_inflow_pressure_, last_inflow_flux_};
+  return {time_,     steps_,    u_, u_previous_, dt_previous_, has_previous_, conductivity_, balance_,
+          last_inflow_pressure_, last_inflow_flux_, fixed_by_, pressure_bc_slot_, open_pressure_};
 }
 
 void Solver::restore_state(const State& s) {
@@ -484,6 +514,13 @@ void Solver::restore_state(const State& s) {
   balance_ = s.balance;
   last_inflow_pressure_ = s.last_inflow_pressure;
   last_inflow_flux_ = s.last_inflow_flux;
+  pressure_bc_slot_ = s.pressure_bc_slot;
+  open_pressure_ = s.open_pressure;
+  if (s.fixed_by != fixed_by_) {
+    fixed_by_ = s.fixed_by;
+    find_dirichlet_entries();
+    ++conductivity_version_;
+  }
   if (s.conductivity != conductivity_) {
     conductivity_ = s.conductivity;
     assemble_conductivity();

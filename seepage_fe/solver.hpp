@@ -86,6 +86,10 @@ class Solver {
   void set_conductivity(const std::vector<double>& per_cell);
   const std::vector<double>& conductivity() const { return conductivity_; }
   void set_source(SourceFunction source) { source_ = std::move(source); }
+  // Nodes touching open space (the tunnel, a cavity the coal has left) held at
+  // `pressure` [Pa], on top of the scene's pressure boundaries; the gas they
+  // take is booked as outflow to "open space". Replaces the previous set.
+  void set_open_nodes(const std::vector<char>& open, double pressure);
   // Replace the initial nodal pressures p [Pa] (before the first step only).
   void set_initial_pressure(const std::vector<double>& nodal_p);
   // p [Pa] and grad p [Pa/m] at any point of the mesh; nullopt outside it.
@@ -102,6 +106,9 @@ class Solver {
     Balance balance;
     std::vector<double> last_inflow_pressure;  // BDF2 flux quadrature memory
     double last_inflow_flux;
+    std::vector<int> fixed_by;  // which condition holds each node (open space included)
+    std::vector<int> pressure_bc_slot;
+    double open_pressure;
   };
   State save_state() const;
   void restore_state(const State& state);
@@ -147,6 +154,9 @@ class Solver {
   std::vector<int> pressure_bc_slot_;  // condition index -> slot in balance vectors
   std::vector<int> dirichlet_zero_;    // value indices zeroed in the Jacobian
   std::vector<int> dirichlet_diagonal_;
+  void find_dirichlet_entries();
+  std::vector<int> boundary_fixed_by_;  // fixed_by_ as the scene's conditions alone set it
+  double open_pressure_ = 0;
 
   std::vector<double> conductivity_;
   long conductivity_version_ = 0;

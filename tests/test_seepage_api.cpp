@@ -113,3 +113,27 @@ TEST_CASE("a step that cannot be completed stops with a clear message", "[seepag
   CHECK_THROWS_WITH(s.advance(86400), Catch::Contains("could not be completed") &&
                                           Catch::Contains("halved 2 times"));
 }
+
+TEST_CASE("open nodes hold the open pressure, book their gas as outflow, and roll back with the state",
+          "[seepage][api][open]") {
+  // A sealed seam (no boundary conditions): opening a column of nodes in the
+  // middle (a cavity) drains it; closing them again seals it.
+  auto s = rectangle_solver(seepage::Law::gas, {10, 1}, {20, 2}, {1e-17, 2e-3, 3e6}, {});
+  s.advance(600);
+  const auto saved = s.save_state();
+  std::vector<char> open(s.mesh().num_nodes(), 0);
+  for (std::size_t i = 0; i < open.size(); ++i) open[i] = std::abs(s.mesh().nodes[i].x() - 5.0) < 1e-9;
+  s.set_open_nodes(open, 1e5);
+  for (int k = 0; k < 5; ++k) s.advance(3600);
+  CHECK(*s.pressure_at({5.0, 0.5}) == Approx(1e5).epsilon(1e-12));
+  CHECK(*s.pressure_at({4.0, 0.5}) < 3e6);
+  const auto& b = s.balance();
+  REQUIRE(b.pressure_boundaries.back() == "open space");
+  CHECK(b.total_outflow() > 0);
+  std::printf("\nopen nodes: released %.4g m3/m, balance error %.2e\n", b.total_outflow(), b.error());
+  CHECK(std::abs(b.error()) < 1e-9 * b.total_outflow());
+  // Rolling back restores the sealed seam: the pressure stays uniform.
+  s.restore_state(saved);
+  s.advance(3600);
+  CHECK(*s.pressure_at({5.0, 0.5}) == Approx(3e6).epsilon(1e-9));
+}
