@@ -498,6 +498,20 @@ StepInfo Solver::step(double dt) {
   return info;
 }
 
+void Solver::add_isotropic_stress(const std::vector<double>& per_particle) {
+  if (steps_ > 0) throw std::logic_error("add_isotropic_stress: the run has already started");
+  if (per_particle.size() != particles_.size())
+    throw std::invalid_argument(fmt::format("add_isotropic_stress: {} values for {} particles", per_particle.size(),
+                                            particles_.size()));
+  auto& p = particles_;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    p.stress[i].diagonal().array() += per_particle[i];
+    p.stress_zz[i] += per_particle[i];
+    p.effective_stress[i].diagonal().array() += per_particle[i];
+    p.effective_stress_zz[i] += per_particle[i];
+  }
+}
+
 void Solver::restore_state(const State& s) {
   dissipated_ = s.dissipated;
   time_ = s.time;

@@ -119,6 +119,9 @@ class Solver {
   // Read access, and the per-particle external force another program sets.
   const Particles<2>& particles() const { return particles_; }
   std::vector<Vec<2>>& external_force() { return particles_.external_force; }
+  // Adds s_p to each particle's normal stresses (in-plane and out-of-plane)
+  // before the first step: alpha p when a coupled scene gives total stresses.
+  void add_isotropic_stress(const std::vector<double>& per_particle);
 
   struct State {
     double time;

@@ -70,7 +70,8 @@ inline Integrals integrals(const Corners& x) {
 // (with a small tolerance so points on shared edges are found).
 inline std::optional<Eigen::Vector2d> inverse_map(const Corners& x, const Eigen::Vector2d& point) {
   Eigen::Vector2d ref = Eigen::Vector2d::Zero();
-  for (int it = 0; it < 20; ++it) {
+  bool converged = false;
+  for (int it = 0; it < 30; ++it) {
     const auto n = shape(ref.x(), ref.y());
     Eigen::Vector2d mapped = Eigen::Vector2d::Zero();
     Eigen::Matrix2d jac = Eigen::Matrix2d::Zero();
@@ -81,10 +82,15 @@ inline std::optional<Eigen::Vector2d> inverse_map(const Corners& x, const Eigen:
     }
     const Eigen::Vector2d step = jac.inverse() * (point - mapped);
     ref += step;
-    if (step.lpNorm<Eigen::Infinity>() < 1e-13) break;
+    if (step.lpNorm<Eigen::Infinity>() < 1e-13) {
+      converged = true;
+      break;
+    }
     if (ref.lpNorm<Eigen::Infinity>() > 10) return std::nullopt;
   }
-  if (ref.lpNorm<Eigen::Infinity>() > 1 + 1e-9) return std::nullopt;
+  // Newton may wander without converging for points outside the cell (the
+  // bilinear map need not be invertible there): that is a miss, not a hit.
+  if (!converged || ref.lpNorm<Eigen::Infinity>() > 1 + 1e-9) return std::nullopt;
   return ref.cwiseMax(-1.0).cwiseMin(1.0);
 }
 

@@ -1,0 +1,186 @@
+#include "coupler/gas_solid.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+namespace outburst::coupling {
+
+namespace {
+
+[[noreturn]] void unknown_field(const std::string& who, const std::string& field) {
+  throw std::invalid_argument(fmt::format("{} has no field '{}'", who, field));
+}
+
+// The most compressive principal value of a 2D stress (tension positive).
+double smallest_principal(double xx, double yy, double xy) {
+  const double mean = 0.5 * (xx + yy), radius = std::hypot(0.5 * (xx - yy), xy);
+  return mean - radius;
+}
+
+}  // namespace
+
+double PermeabilityLaw::operator()(double lambda0, double compression, double damage) const {
+  const double exponent = std::clamp(-beta * compression, -max_exponent, max_exponent);
+  const double factor = damage >= full_damage ? xi_full : damage > 0 ? xi : 1.0;
+  return lambda0 * std::exp(exponent) * factor;
+}
+
+// ---- seepage
+
+SeepageParticipant::SeepageParticipant(seepage::Solver& solver, GasSolidSettings settings)
+    : solver_(solver), settings_(settings), lambda0_(solver.conductivity()) {
+  const auto nc = static_cast<Eigen::Index>(solver_.mesh().num_cells());
+  occupancy_ = Eigen::VectorXd::Ones(nc);
+  stress_ = Eigen::VectorXd::Zero(3 * nc);
+  damage_ = Eigen::VectorXd::Zero(nc);
+}
+
+void SeepageParticipant::write(const std::string& field, const Eigen::VectorXd& values) {
+  Eigen::VectorXd* target = field == "occupancy" ? &occupancy_
+                            : field == "stress"  ? &stress_
+                            : field == "damage"  ? &damage_
+                                                 : nullptr;
+  if (!target) unknown_field(name(), field);
+  if (values.size() != target->size())
+    throw std::invalid_argument(
+        fmt::format("seepage: field '{}' has {} values, expected {}", field, values.size(), target->size()));
+  *target = values;
+}
+
+Eigen::VectorXd SeepageParticipant::read(const std::string& field) const {
+  if (field != "pressure") unknown_field(name(), field);
+  const auto p = solver_.nodal_pressure();
+  return Eigen::Map<const Eigen::VectorXd>(p.data(), static_cast<Eigen::Index>(p.size()));
+}
+
+// Cells the coal has left are open space, and so is every node touching one;
+// the rest get the permeability of their stress and damage.
+void SeepageParticipant::apply_solid_state() {
+  const auto& mesh = solver_.mesh();
+  const std::size_t nc = mesh.num_cells();
+  std::vector<char> open(mesh.num_nodes(), 0);
+  open_cells_ = 0;
+  for (std::size_t c = 0; c < nc; ++c) {
+    if (occupancy_[static_cast<Eigen::Index>(c)] >= settings_.open_below) continue;
+    ++open_cells_;
+    for (int node : mesh.cells[c]) open[node] = 1;
+  }
+  solver_.set_open_nodes(open, settings_.open_pressure);
+  if (!settings_.permeability_coupling) return;
+  std::vector<double> lambda(nc);
+  for (std::size_t c = 0; c < nc; ++c) {
+    const auto i = static_cast<Eigen::Index>(c);
+    const double compression = -smallest_principal(stress_[3 * i], stress_[3 * i + 1], stress_[3 * i + 2]);
+    lambda[c] = settings_.permeability(lambda0_[c], compression, std::clamp(damage_[i], 0.0, 1.0));
+  }
+  solver_.set_conductivity(lambda);
+}
+
+void SeepageParticipant::advance(double window) {
+  apply_solid_state();
+  solver_.advance(window);
+}
+
+void SeepageParticipant::save() { saved_ = solver_.save_state(); }
+void SeepageParticipant::restore() { solver_.restore_state(saved_); }
+
+// ---- solid
+
+SolidParticipant::SolidParticipant(mpm::Solver& solver, const MeshMapping& mapping, double biot,
+                                   Eigen::VectorXd pressure, std::optional<double> fixed_time_step)
+    : solver_(solver),
+      mapping_(mapping),
+      biot_(biot),
+      fixed_time_step_(fixed_time_step),
+      pressure_start_(pressure),
+      pressure_end_(std::move(pressure)) {
+  if (pressure_start_.size() != static_cast<Eigen::Index>(mapping_.mesh().num_nodes()))
+    throw std::invalid_argument("solid: the initial pressure does not match the seepage mesh");
+}
+
+void SolidParticipant::make_initial_stress_effective() {
+  const auto& p = solver_.particles();
+  std::vector<double> shift(p.size(), 0.0);
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (const auto s = mapping_.sample(pressure_start_, p.x[i])) shift[i] = biot_ * s->value;
+  solver_.add_isotropic_stress(shift);
+  averages_.reset();
+}
+
+void SolidParticipant::write(const std::string& field, const Eigen::VectorXd& values) {
+  if (field != "pressure") unknown_field(name(), field);
+  if (values.size() != pressure_end_.size())
+    throw std::invalid_argument(fmt::format("solid: field 'pressure' has {} values, expected {}", values.size(),
+                                            pressure_end_.size()));
+  pressure_end_ = values;
+}
+
+void SolidParticipant::compute_averages() const {
+  if (averages_) return;
+  const auto& p = solver_.particles();
+  std::vector<double> values(4 * p.size());
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    values[4 * i] = p.stress[i](0, 0);
+    values[4 * i + 1] = p.stress[i](1, 1);
+    values[4 * i + 2] = p.stress[i](0, 1);
+    values[4 * i + 3] = p.damage[i];
+  }
+  averages_ = mapping_.average(p.x, p.volume, values, 4);
+}
+
+Eigen::VectorXd SolidParticipant::read(const std::string& field) const {
+  compute_averages();
+  const auto& a = *averages_;
+  const auto nc = static_cast<Eigen::Index>(a.fraction.size());
+  if (field == "occupancy") return Eigen::Map<const Eigen::VectorXd>(a.fraction.data(), nc);
+  const Eigen::Map<const Eigen::MatrixXd> mean(a.mean.data(), 4, nc);
+  if (field == "stress") {
+    const Eigen::MatrixXd top = mean.topRows(3);
+    return Eigen::Map<const Eigen::VectorXd>(top.data(), 3 * nc);
+  }
+  if (field == "damage") return mean.row(3).transpose();
+  unknown_field(name(), field);
+}
+
+// The gas force -alpha grad(p) V_p with p interpolated between the window's
+// ends at `fraction` of it.
+void SolidParticipant::set_gas_force(double fraction) {
+  const auto& p = solver_.particles();
+  auto& force = solver_.external_force();
+  const Eigen::VectorXd pressure = (1 - fraction) * pressure_start_ + fraction * pressure_end_;
+  const int n = static_cast<int>(p.size());
+#pragma omp parallel for schedule(static)
+  for (int i = 0; i < n; ++i) {
+    const auto s = mapping_.sample(pressure, p.x[i]);
+    force[i] = s ? mpm::Vec<2>(-biot_ * p.volume[i] * s->gradient) : mpm::Vec<2>::Zero();
+  }
+}
+
+void SolidParticipant::advance(double window) {
+  const double start = solver_.time(), end = start + window;
+  while (solver_.time() < end - 1e-12 * window) {
+    const double dt = std::min(fixed_time_step_ ? *fixed_time_step_ : solver_.stable_time_step(), end - solver_.time());
+    // The force at the middle of the step (explicit steps are short: the
+    // pressure barely changes over one).
+    set_gas_force((solver_.time() + 0.5 * dt - start) / window);
+    const auto info = solver_.step(dt);
+    if (on_step) on_step(info);
+  }
+  pressure_start_ = pressure_end_;
+  averages_.reset();
+}
+
+void SolidParticipant::save() {
+  saved_ = solver_.save_state();
+  saved_pressure_ = pressure_start_;
+}
+
+void SolidParticipant::restore() {
+  solver_.restore_state(saved_);
+  pressure_start_ = saved_pressure_;
+  averages_.reset();
+}
+
+}  // namespace outburst::coupling

@@ -1,0 +1,105 @@
+#pragma once
+// The gas-solid coupling of the outburst: the two solvers as coupling
+// participants, and the permeability law that turns the solid's state into the
+// seepage's conductivity.
+//
+// Stress split (model-notes section 2): total = effective - alpha p I, tension
+// positive. The MPM solver carries the effective stress; the gas acts on the
+// solid as the body force -alpha grad(p) V_p per particle. Tractions and
+// initial stresses of an MPM body are therefore effective ones; a coupled
+// scene may give total initial stresses and have alpha p0 added.
+//
+// Seepage is the first participant, the solid the second:
+//   seepage -> solid: "pressure", nodal p [Pa] at the window's end; the solid
+//     interpolates it linearly in time over the window, in space with the Q1
+//     shape functions, at every MPM step.
+//   solid -> seepage: per seepage cell, "occupancy" (solid volume fraction),
+//     "stress" (volume-averaged effective stress xx, yy, xy [Pa]) and "damage".
+
+#include <functional>
+#include <optional>
+#include <vector>
+
+#include "coupler/coupling.hpp"
+#include "coupler/mapping.hpp"
+#include "mpm_solid/solver.hpp"
+#include "seepage_fe/solver.hpp"
+
+namespace outburst::coupling {
+
+// lambda = lambda0 exp(-beta sigma') f(D)  (paper eqs. 12 and 14, model-notes
+// section 3): sigma' the largest effective compression (sigma_1 - alpha p of the
+// paper, compression positive), f = 1 intact, xi damaged, xi' fully damaged.
+struct PermeabilityLaw {
+  double beta = 0.2e-6;       // [1/Pa] (the paper's 0.2 1/MPa)
+  double xi = 5;              // damaged (0 < D < 1)
+  double xi_full = 100;       // fragmented (D >= full_damage)
+  double full_damage = 0.99;  // D counted as complete
+  double max_exponent = 10;   // |beta sigma'| clamp: lambda within e^(+-10) of lambda0
+  double operator()(double lambda0, double compression, double damage) const;
+};
+
+struct GasSolidSettings {
+  double biot = 0.5;         // alpha
+  PermeabilityLaw permeability;
+  bool permeability_coupling = true;  // off: lambda stays the scene's
+  double open_below = 0.5;   // a cell with less solid than this fraction is open space
+  double open_pressure = 1e5;  // [Pa] of open space
+};
+
+class SeepageParticipant final : public Participant {
+ public:
+  SeepageParticipant(seepage::Solver& solver, GasSolidSettings settings);
+  std::string name() const override { return "seepage"; }
+  void write(const std::string& field, const Eigen::VectorXd& values) override;
+  Eigen::VectorXd read(const std::string& field) const override;
+  void advance(double window) override;
+  void save() override;
+  void restore() override;
+
+  int open_cells() const { return open_cells_; }
+
+ private:
+  void apply_solid_state();
+
+  seepage::Solver& solver_;
+  GasSolidSettings settings_;
+  std::vector<double> lambda0_;  // the scene's conductivity per cell
+  Eigen::VectorXd occupancy_, stress_, damage_;
+  seepage::Solver::State saved_;
+  int open_cells_ = 0;
+};
+
+class SolidParticipant final : public Participant {
+ public:
+  // `pressure` is the nodal p [Pa] at the start (the seepage's initial state).
+  SolidParticipant(mpm::Solver& solver, const MeshMapping& mapping, double biot, Eigen::VectorXd pressure,
+                   std::optional<double> fixed_time_step);
+  std::string name() const override { return "solid"; }
+  void write(const std::string& field, const Eigen::VectorXd& values) override;
+  Eigen::VectorXd read(const std::string& field) const override;
+  void advance(double window) override;
+  void save() override;
+  void restore() override;
+
+  // Converts total initial stresses to effective: adds alpha p to each
+  // particle's normal stresses (before the first step).
+  void make_initial_stress_effective();
+  // Called after every MPM step (histories, progress).
+  std::function<void(const mpm::StepInfo&)> on_step;
+
+ private:
+  void set_gas_force(double fraction);
+  void compute_averages() const;
+
+  mpm::Solver& solver_;
+  const MeshMapping& mapping_;
+  double biot_;
+  std::optional<double> fixed_time_step_;
+  Eigen::VectorXd pressure_start_, pressure_end_;
+  mpm::Solver::State saved_;
+  Eigen::VectorXd saved_pressure_;
+  mutable std::optional<MeshMapping::Averages> averages_;  // of the current state
+};
+
+}  // namespace outburst::coupling

@@ -1,0 +1,61 @@
+#include "coupler/mapping.hpp"
+
+#include "seepage_fe/q1.hpp"
+
+namespace outburst::coupling {
+
+namespace {
+
+seepage::q1::Corners corners(const seepage::Mesh& mesh, std::size_t c) {
+  seepage::q1::Corners x;
+  for (int a = 0; a < 4; ++a) x[a] = mesh.nodes[mesh.cells[c][a]];
+  return x;
+}
+
+}  // namespace
+
+MeshMapping::MeshMapping(seepage::Mesh mesh) : mesh_(std::move(mesh)), locator_(mesh_) {
+  area_.resize(mesh_.num_cells());
+  for (std::size_t c = 0; c < mesh_.num_cells(); ++c) area_[c] = seepage::q1::integrals(corners(mesh_, c)).lumped.sum();
+}
+
+std::optional<MeshMapping::Sample> MeshMapping::sample(const Eigen::VectorXd& nodal, const Eigen::Vector2d& x) const {
+  const auto hit = locator_.locate(x);
+  if (!hit) return std::nullopt;
+  const auto c = static_cast<std::size_t>(hit->cell);
+  const auto p = seepage::q1::evaluate(corners(mesh_, c), hit->reference.x(), hit->reference.y());
+  Sample s{0.0, Eigen::Vector2d::Zero()};
+  for (int a = 0; a < 4; ++a) {
+    const double u = nodal[mesh_.cells[c][a]];
+    s.value += p.n[a] * u;
+    s.gradient += p.grad[a] * u;
+  }
+  return s;
+}
+
+int MeshMapping::cell_of(const Eigen::Vector2d& x) const {
+  const auto hit = locator_.locate(x);
+  return hit ? hit->cell : -1;
+}
+
+MeshMapping::Averages MeshMapping::average(const std::vector<Eigen::Vector2d>& points,
+                                           const std::vector<double>& volume, const std::vector<double>& values,
+                                           int components) const {
+  const std::size_t nc = mesh_.num_cells(), k = static_cast<std::size_t>(components);
+  Averages a{std::vector<double>(nc, 0.0), std::vector<double>(nc * k, 0.0)};
+  for (std::size_t p = 0; p < points.size(); ++p) {
+    const int c = cell_of(points[p]);
+    if (c < 0) continue;
+    const auto cell = static_cast<std::size_t>(c);
+    a.fraction[cell] += volume[p];
+    for (std::size_t j = 0; j < k; ++j) a.mean[cell * k + j] += volume[p] * values[p * k + j];
+  }
+  for (std::size_t c = 0; c < nc; ++c) {
+    if (a.fraction[c] > 0)
+      for (std::size_t j = 0; j < k; ++j) a.mean[c * k + j] /= a.fraction[c];
+    a.fraction[c] /= area_[c];
+  }
+  return a;
+}
+
+}  // namespace outburst::coupling
