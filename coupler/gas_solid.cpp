@@ -35,6 +35,9 @@ SeepageParticipant::SeepageParticipant(seepage::Solver& solver, GasSolidSettings
   occupancy_ = Eigen::VectorXd::Ones(nc);
   stress_ = Eigen::VectorXd::Zero(3 * nc);
   damage_ = Eigen::VectorXd::Zero(nc);
+  // Registers open space with the solver now, so that its balance (and any
+  // history written from it) has the slot from the start.
+  solver_.set_open_nodes(std::vector<char>(solver_.mesh().num_nodes(), 0), settings_.open_pressure);
 }
 
 void SeepageParticipant::write(const std::string& field, const Eigen::VectorXd& values) {

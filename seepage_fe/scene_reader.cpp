@@ -86,7 +86,7 @@ Material read_material(const scene::Table& r, Law law) {
 
 }  // namespace
 
-Setup read_setup(const scene::Table& s) {
+Setup read_setup(const scene::Table& s, bool own_time_steps) {
   Setup setup;
   Model& model = setup.model;
   model.law = s.choice({"law",
@@ -115,14 +115,15 @@ Setup read_setup(const scene::Table& s) {
   st.max_step_cuts = static_cast<int>(s.integer(
       {"max_step_cuts", "halvings of a failing step before the run stops", "12", Range::at_least(0)}));
 
-  setup.steps.first = s.quantity({"time_step", "first time step", "", Range::positive()}, units::time);
-  setup.steps.growth = s.number({"time_step_growth",
-                                 "factor between successive steps (1: constant; up to 2)", "1",
-                                 Range::between(1, 2)});
   setup.steps.maximum = std::numeric_limits<double>::infinity();
-  if (s.has("max_time_step"))
-    setup.steps.maximum = s.quantity(
-        {"max_time_step", "largest step when time_step_growth > 1", "", Range::positive()}, units::time);
+  if (own_time_steps) {
+    setup.steps.first = s.quantity({"time_step", "first time step", "", Range::positive()}, units::time);
+    setup.steps.growth = s.number({"time_step_growth", "factor between successive steps (1: constant; up to 2)",
+                                   "1", Range::between(1, 2)});
+    if (s.has("max_time_step"))
+      setup.steps.maximum = s.quantity(
+          {"max_time_step", "largest step when time_step_growth > 1", "", Range::positive()}, units::time);
+  }
 
   auto mesh_or_spec = read_mesh(*s.table("mesh", "the finite element mesh", true));
 

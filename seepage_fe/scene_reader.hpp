@@ -19,9 +19,11 @@ struct Setup {
   Mesh mesh;
   Model model;
   Settings settings;
-  TimeStepControl steps;
+  TimeStepControl steps{};
 };
 
-Setup read_setup(const scene::Table& seepage);
+// own_time_steps: read time_step and its growth (false when a coupling window
+// sets the steps, so a coupled scene does not carry keys nothing uses).
+Setup read_setup(const scene::Table& seepage, bool own_time_steps = true);
 
 }  // namespace outburst::seepage

@@ -152,7 +152,7 @@ TEST_CASE("coupling schemes: one-way and explicit pass once, implicit repeats to
     CHECK(second.output_[0] == 6);
     CHECK(c.records().back().iterations == 1);
   }
-  SECTION("implicit converges to the fixed point y = 2 (y + 1) * -0.4 ...") {
+  SECTION("implicit converges to the fixed point y = -0.4 (y + 1)") {
     // first: x = y + 1; second: y = -0.4 x; fixed point y = -0.4 / 1.4.
     Mock first("first", 1, 1), second("second", -0.4, 0);
     s.kind = SchemeSettings::Kind::implicit;
@@ -165,7 +165,7 @@ TEST_CASE("coupling schemes: one-way and explicit pass once, implicit repeats to
   }
 }
 
-TEST_CASE("coupling: a non-finite field stops the window naming it; a diverged window is never converged",
+TEST_CASE("coupling: a non-finite field stops the window naming it, and a diverged window is never converged",
           "[coupler][scheme]") {
   SchemeSettings s;
   s.kind = SchemeSettings::Kind::implicit;

@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "common/program.hpp"
+#include "coupler/scene_reader.hpp"
 #include "mpm_solid/scene_reader.hpp"
 #include "seepage_fe/scene_reader.hpp"
 
@@ -18,10 +19,12 @@ TEST_CASE("shipped scenes are valid", "[scene][cases]") {
     auto doc = scene::Document::load(entry.path());
     auto root = doc->root();
     const auto header = read_scene_header(root);
+    const bool coupled = header.solvers.size() == 2;
     for (const auto& solver : header.solvers) {
-      if (solver == "seepage") REQUIRE_NOTHROW(seepage::read_setup(*root.table("seepage", "", true)));
+      if (solver == "seepage") REQUIRE_NOTHROW(seepage::read_setup(*root.table("seepage", "", true), !coupled));
       if (solver == "mpm") REQUIRE_NOTHROW(mpm::read_setup(*root.table("mpm", "", true)));
     }
+    if (coupled) REQUIRE_NOTHROW(coupling::read_coupling(*root.table("coupling", "", true)));
     REQUIRE_NOTHROW(doc->reject_unused());
     ++checked;
   }

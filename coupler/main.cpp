@@ -1,0 +1,112 @@
+// outburst: the coupled gas-solid simulation. The seepage solver and the MPM
+// solver run as partners of a coupling (coupler/coupling.hpp) window by window.
+#include <chrono>
+#include <fstream>
+
+#include <spdlog/spdlog.h>
+
+#include "common/program.hpp"
+#include "common/progress.hpp"
+#include "coupler/scene_reader.hpp"
+#include "mpm_solid/output.hpp"
+#include "mpm_solid/scene_reader.hpp"
+#include "seepage_fe/output.hpp"
+#include "seepage_fe/scene_reader.hpp"
+
+using namespace outburst;
+
+namespace {
+
+// Per window: what the coupling cost and how it converged, flushed line by line.
+class WindowLog {
+ public:
+  WindowLog(const std::filesystem::path& file, const std::vector<coupling::Convergence>& fields) : out_(file) {
+    out_ << "window,time,size,iterations,converged,seepage_s,solid_s,coupler_s,open_cells,gas_released,"
+            "kinetic_energy,particles";
+    for (const auto& f : fields) out_ << ",residual_" << f.field;
+    out_ << '\n';
+  }
+  void write(std::size_t index, const coupling::WindowRecord& r, int open_cells, double released, double kinetic,
+             std::size_t particles) {
+    out_ << fmt::format("{},{:.9g},{:.6g},{},{},{:.4g},{:.4g},{:.4g},{},{:.9g},{:.9g},{}", index, r.start + r.size,
+                        r.size, r.iterations, r.converged ? 1 : 0, r.first_seconds, r.second_seconds,
+                        r.coupler_seconds, open_cells, released, kinetic, particles);
+    for (double v : r.residuals) out_ << fmt::format(",{:.3e}", v);
+    out_ << '\n';
+    out_.flush();
+  }
+
+ private:
+  std::ofstream out_;
+};
+
+int run(const RunOptions& options, scene::Document& doc) {
+  auto root = doc.root();
+  const SceneHeader header = read_scene_header(root);
+  require_solvers(root, header, {"seepage", "mpm"}, "outburst");
+  if (header.solvers.size() != 2)
+    root.table("scene", "", true)->fail("solvers", "outburst couples \"seepage\" and \"mpm\"; run seepage-fe or "
+                                                   "mpm-solid for one alone");
+  seepage::Setup seep = seepage::read_setup(*root.table("seepage", "the gas seepage solver", true), false);
+  mpm::Setup solid_setup = mpm::read_setup(*root.table("mpm", "the material point solver", true));
+  const coupling::CouplingSetup cs = coupling::read_coupling(*root.table("coupling", "the gas-solid coupling", true));
+  if (!finish_reading(options, doc)) return 0;
+
+  seepage::Solver seepage_solver(seep.mesh, seep.model, seep.settings);
+  mpm::Solver solid(solid_setup.grid, std::move(solid_setup.materials), std::move(solid_setup.particles),
+                    solid_setup.settings);
+  const coupling::MeshMapping mapping(std::move(seep.mesh));
+  coupling::SeepageParticipant seepage_side(seepage_solver, cs.gas_solid);
+  coupling::SolidParticipant solid_side(solid, mapping, cs.gas_solid.biot, seepage_side.read("pressure"),
+                                        solid_setup.fixed_time_step);
+  if (cs.total_initial_stress) solid_side.make_initial_stress_effective();
+  coupling::Coupling coupler(seepage_side, solid_side, cs.scheme);
+  spdlog::info("{}: {} seepage cells, {} particles, window {:.3g} s", header.title, mapping.mesh().num_cells(),
+               solid.particles().size(), cs.window);
+
+  const auto directory = options.output_directory();
+  const auto info = run_info("outburst", doc, "SI: m, s, kg, Pa; 2D plane strain, per metre of depth; MPM stresses "
+                                              "are effective (total = effective - alpha p I)");
+  seepage::Output seepage_out(directory, info, seepage_solver);
+  mpm::Output solid_out(directory, info, solid_setup.tracers);
+  WindowLog log(directory / "coupling.csv", cs.scheme.to_first);
+  seepage_out.snapshot(seepage_solver);
+  solid_out.snapshot(solid);
+
+  const auto wall_start = std::chrono::steady_clock::now();
+  Progress progress("outburst", 0.0, header.end_time, options.show_progress());
+  double next_output = header.output_interval;
+  long iterations = 0;
+  while (coupler.time() < header.end_time * (1 - 1e-12)) {
+    const double target = std::min(next_output, header.end_time);
+    const double window = std::min(cs.window, target - coupler.time());
+    const auto& r = coupler.advance(window);
+    iterations += r.iterations;
+    solid_out.history(solid, mpm::StepInfo{window, 0});
+    seepage_out.history(seepage_solver, window, seepage::StepReport{});
+    log.write(coupler.records().size(), r, seepage_side.open_cells(), seepage_solver.balance().total_outflow(),
+              solid.energies().kinetic, solid.particles().size());
+    progress.update(static_cast<long>(coupler.records().size()), coupler.time(), window,
+                    fmt::format("sub-iterations {}", r.iterations));
+    if (coupler.time() >= target * (1 - 1e-12)) {
+      seepage_out.snapshot(seepage_solver);
+      solid_out.snapshot(solid);
+      next_output += header.output_interval;
+    }
+  }
+  progress.finish();
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  spdlog::info("done: {} windows, {} sub-iterations, {} MPM steps, {:.3g} s wall; gas released {:.4g} m3/m, "
+               "{} particles left the grid",
+               coupler.records().size(), iterations, solid.steps(), wall, seepage_solver.balance().total_outflow(),
+               solid.removed_particles());
+  spdlog::info("results: {}", std::filesystem::absolute(directory).string());
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return run_program("outburst", "Coal-and-gas outburst: seepage (FE) and coal (MPM) coupled by windows", argc, argv,
+                     run);
+}
