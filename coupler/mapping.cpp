@@ -1,36 +1,17 @@
 #include "coupler/mapping.hpp"
 
-#include "seepage_fe/q1.hpp"
-
 namespace outburst::coupling {
-
-namespace {
-
-seepage::q1::Corners corners(const seepage::Mesh& mesh, std::size_t c) {
-  seepage::q1::Corners x;
-  for (int a = 0; a < 4; ++a) x[a] = mesh.nodes[mesh.cells[c][a]];
-  return x;
-}
-
-}  // namespace
 
 MeshMapping::MeshMapping(seepage::Mesh mesh) : mesh_(std::move(mesh)), locator_(mesh_) {
   area_.resize(mesh_.num_cells());
-  for (std::size_t c = 0; c < mesh_.num_cells(); ++c) area_[c] = seepage::q1::integrals(corners(mesh_, c)).lumped.sum();
+  for (std::size_t c = 0; c < mesh_.num_cells(); ++c) area_[c] = seepage::q1::integrals(mesh_.corners(c)).lumped.sum();
 }
 
 std::optional<MeshMapping::Sample> MeshMapping::sample(const Eigen::VectorXd& nodal, const Eigen::Vector2d& x) const {
   const auto hit = locator_.locate(x);
   if (!hit) return std::nullopt;
   const auto c = static_cast<std::size_t>(hit->cell);
-  const auto p = seepage::q1::evaluate(corners(mesh_, c), hit->reference.x(), hit->reference.y());
-  Sample s{0.0, Eigen::Vector2d::Zero()};
-  for (int a = 0; a < 4; ++a) {
-    const double u = nodal[mesh_.cells[c][a]];
-    s.value += p.n[a] * u;
-    s.gradient += p.grad[a] * u;
-  }
-  return s;
+  return seepage::q1::sample(mesh_.corners(c), mesh_.cells[c], nodal, hit->reference);
 }
 
 int MeshMapping::cell_of(const Eigen::Vector2d& x) const {

@@ -19,6 +19,7 @@
 
 #include "seepage_fe/cell_locator.hpp"
 #include "seepage_fe/mesh.hpp"
+#include "seepage_fe/q1.hpp"
 
 namespace outburst::coupling {
 
@@ -31,10 +32,7 @@ class MeshMapping {
   const seepage::Mesh& mesh() const { return mesh_; }
   const std::vector<double>& cell_area() const { return area_; }
 
-  struct Sample {
-    double value;
-    Eigen::Vector2d gradient;
-  };
+  using Sample = seepage::q1::Sample;
   // Nodal field and its gradient at x; nullopt outside the mesh.
   std::optional<Sample> sample(const Eigen::VectorXd& nodal, const Eigen::Vector2d& x) const;
   // The cell holding x, or -1.

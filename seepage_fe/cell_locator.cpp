@@ -7,15 +7,6 @@
 
 namespace outburst::seepage {
 
-namespace {
-
-q1::Corners corners(const Mesh& mesh, int cell) {
-  const auto& c = mesh.cells[static_cast<std::size_t>(cell)];
-  return {mesh.nodes[c[0]], mesh.nodes[c[1]], mesh.nodes[c[2]], mesh.nodes[c[3]]};
-}
-
-}  // namespace
-
 CellLocator::CellLocator(const Mesh& mesh) : mesh_(mesh) {
   Eigen::Vector2d lo = mesh.nodes.front(), hi = mesh.nodes.front();
   for (const auto& p : mesh.nodes) {
@@ -62,7 +53,7 @@ std::optional<CellLocator::Hit> CellLocator::locate(const Eigen::Vector2d& point
   const int b = j * nx_ + i;
   for (int k = bucket_start_[b]; k < bucket_start_[b + 1]; ++k) {
     const int cell = bucket_cells_[k];
-    if (const auto ref = q1::inverse_map(corners(mesh_, cell), point)) return Hit{cell, *ref};
+    if (const auto ref = q1::inverse_map(mesh_.corners(static_cast<std::size_t>(cell)), point)) return Hit{cell, *ref};
   }
   return std::nullopt;
 }

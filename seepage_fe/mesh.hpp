@@ -29,6 +29,10 @@ struct Mesh {
 
   std::size_t num_nodes() const { return nodes.size(); }
   std::size_t num_cells() const { return cells.size(); }
+  std::array<Eigen::Vector2d, 4> corners(std::size_t cell) const {
+    const auto& c = cells[cell];
+    return {nodes[c[0]], nodes[c[1]], nodes[c[2]], nodes[c[3]]};
+  }
   // -1 when absent.
   int region_index(const std::string& name) const;
   const Boundary* boundary(const std::string& name) const;

@@ -44,6 +44,24 @@ inline Point evaluate(const Corners& x, double xi, double eta) {
   return p;
 }
 
+// A nodal field (indexed by node number) and its gradient at a reference
+// point of the cell with these corners and nodes.
+struct Sample {
+  double value;
+  Eigen::Vector2d gradient;
+};
+template <class Nodal>
+Sample sample(const Corners& x, const std::array<int, 4>& nodes, const Nodal& u, const Eigen::Vector2d& reference) {
+  const Point p = evaluate(x, reference.x(), reference.y());
+  Sample s{0.0, Eigen::Vector2d::Zero()};
+  for (int a = 0; a < 4; ++a) {
+    const double ua = u[nodes[a]];
+    s.value += p.n[a] * ua;
+    s.gradient += p.grad[a] * ua;
+  }
+  return s;
+}
+
 // 2x2 Gauss rule, exact for the bilinear stiffness on parallelograms.
 inline constexpr double gauss2 = 0.57735026918962576451;  // 1/sqrt(3)
 inline constexpr std::array<std::array<double, 2>, 4> gauss2_points{

@@ -30,11 +30,6 @@ class ScopedTimer {
   Clock::time_point start_;
 };
 
-q1::Corners corners(const Mesh& mesh, std::size_t cell) {
-  const auto& c = mesh.cells[cell];
-  return {mesh.nodes[c[0]], mesh.nodes[c[1]], mesh.nodes[c[2]], mesh.nodes[c[3]]};
-}
-
 }  // namespace
 
 double Balance::error() const {
@@ -89,7 +84,7 @@ void Solver::setup_system() {
   std::vector<Eigen::Triplet<double>> pattern;
   pattern.reserve(nc * 16);
   for (std::size_t c = 0; c < nc; ++c) {
-    const auto integrals = q1::integrals(corners(mesh_, c));
+    const auto integrals = q1::integrals(mesh_.corners(c));
     cell_stiffness_[c] = integrals.stiffness;
     const Material& m = model_.materials[mesh_.cell_region[c]];
     conductivity_[c] = m.conductivity;
@@ -251,7 +246,7 @@ void Solver::load_vector(double t, Eigen::VectorXd& f) const {
   }
   if (!source_) return;
   for (std::size_t c = 0; c < mesh_.num_cells(); ++c) {
-    const auto x = corners(mesh_, c);
+    const auto x = mesh_.corners(c);
     for (const auto& g : q1::gauss2_points) {
       const auto p = q1::evaluate(x, g[0], g[1]);
       Eigen::Vector2d at = Eigen::Vector2d::Zero();
@@ -468,18 +463,11 @@ std::optional<double> Solver::pressure_at(const Eigen::Vector2d& x) const {
 std::optional<Eigen::Vector2d> Solver::pressure_gradient_at(const Eigen::Vector2d& x) const {
   const auto hit = locator_.locate(x);
   if (!hit) return std::nullopt;
-  const auto p = q1::evaluate(corners(mesh_, static_cast<std::size_t>(hit->cell)),
-                              hit->reference.x(), hit->reference.y());
-  double u = 0;
-  Eigen::Vector2d grad = Eigen::Vector2d::Zero();
-  for (int a = 0; a < 4; ++a) {
-    const double ua = u_[mesh_.cells[hit->cell][a]];
-    u += p.n[a] * ua;
-    grad += p.grad[a] * ua;
-  }
-  if (model_.law == Law::linear) return grad;
+  const auto cell = static_cast<std::size_t>(hit->cell);
+  const auto s = q1::sample(mesh_.corners(cell), mesh_.cells[cell], u_, hit->reference);
+  if (model_.law == Law::linear) return s.gradient;
   // grad p = grad P / (2 p)
-  return grad / (2.0 * std::sqrt(std::max(u, 1e-300)));
+  return s.gradient / (2.0 * std::sqrt(std::max(s.value, 1e-300)));
 }
 
 std::vector<double> Solver::nodal_pressure() const {
@@ -491,7 +479,7 @@ std::vector<double> Solver::nodal_pressure() const {
 std::vector<Eigen::Vector2d> Solver::cell_flux() const {
   std::vector<Eigen::Vector2d> q(mesh_.num_cells());
   for (std::size_t c = 0; c < mesh_.num_cells(); ++c) {
-    const auto p = q1::evaluate(corners(mesh_, c), 0.0, 0.0);
+    const auto p = q1::evaluate(mesh_.corners(c), 0.0, 0.0);
     Eigen::Vector2d grad = Eigen::Vector2d::Zero();
     for (int a = 0; a < 4; ++a) grad += p.grad[a] * u_[mesh_.cells[c][a]];
     q[c] = -conductivity_[c] * grad;
