@@ -103,7 +103,6 @@ Eigen::VectorXd IqnIls::next(const Eigen::VectorXd& y, const Eigen::VectorXd& x)
     q.push_back(a / rest);
     kept.push_back(j);
   }
-  columns_used_ = static_cast<int>(kept.size());
   if (kept.empty()) return y + settings_.relaxation * r;
 
   Eigen::MatrixXd v(r.size(), static_cast<Eigen::Index>(kept.size()));

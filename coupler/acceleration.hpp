@@ -93,8 +93,6 @@ class IqnIls final : public Acceleration {
   void start_window(const std::vector<FieldSlice>& fields) override;
   Eigen::VectorXd next(const Eigen::VectorXd& y, const Eigen::VectorXd& x) override;
   void end_window(bool converged) override;
-  // Columns used by the last least-squares solve (after filtering).
-  int columns_used() const { return columns_used_; }
 
  private:
   AccelerationSettings settings_;
@@ -102,7 +100,6 @@ class IqnIls final : public Acceleration {
   std::deque<Eigen::VectorXd> v_, w_;
   std::deque<std::deque<Eigen::VectorXd>> past_v_, past_w_;
   Eigen::VectorXd previous_residual_, previous_output_;
-  int columns_used_ = 0;
 };
 
 }  // namespace outburst::coupling

@@ -48,7 +48,7 @@ class CouplingError : public std::runtime_error {
 // tolerance is not used).
 struct Convergence {
   std::string field;
-  double relative = 1e-4;
+  double relative = 1e-3;
   double absolute = 0;
 };
 

@@ -83,7 +83,7 @@ void SeepageParticipant::apply_solid_state() {
 
 void SeepageParticipant::advance(double window) {
   apply_solid_state();
-  solver_.advance(window);
+  last_report_ = solver_.advance(window);
 }
 
 void SeepageParticipant::save() { saved_ = solver_.save_state(); }
@@ -152,24 +152,26 @@ Eigen::VectorXd SolidParticipant::read(const std::string& field) const {
 void SolidParticipant::set_gas_force(double fraction) {
   const auto& p = solver_.particles();
   auto& force = solver_.external_force();
-  const Eigen::VectorXd pressure = (1 - fraction) * pressure_start_ + fraction * pressure_end_;
+  pressure_now_ = (1 - fraction) * pressure_start_ + fraction * pressure_end_;
   const int n = static_cast<int>(p.size());
 #pragma omp parallel for schedule(static)
   for (int i = 0; i < n; ++i) {
-    const auto s = mapping_.sample(pressure, p.x[i]);
+    const auto s = mapping_.sample(pressure_now_, p.x[i]);
     force[i] = s ? mpm::Vec<2>(-biot_ * p.volume[i] * s->gradient) : mpm::Vec<2>::Zero();
   }
 }
 
 void SolidParticipant::advance(double window) {
   const double start = solver_.time(), end = start + window;
+  last_window_ = {0};
   while (solver_.time() < end - 1e-12 * window) {
     const double dt = std::min(fixed_time_step_ ? *fixed_time_step_ : solver_.stable_time_step(), end - solver_.time());
     // The force at the middle of the step (explicit steps are short: the
     // pressure barely changes over one).
     set_gas_force((solver_.time() + 0.5 * dt - start) / window);
     const auto info = solver_.step(dt);
-    if (on_step) on_step(info);
+    last_window_.dt = info.dt;
+    last_window_.removed += info.removed;
   }
   pressure_start_ = pressure_end_;
   averages_.reset();

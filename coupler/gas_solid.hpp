@@ -16,7 +16,6 @@
 //   solid -> seepage: per seepage cell, "occupancy" (solid volume fraction),
 //     "stress" (volume-averaged effective stress xx, yy, xy [Pa]) and "damage".
 
-#include <functional>
 #include <optional>
 #include <vector>
 
@@ -58,6 +57,8 @@ class SeepageParticipant final : public Participant {
   void restore() override;
 
   int open_cells() const { return open_cells_; }
+  // The seepage solver's report of the last advance (sub-steps, cuts, iterations).
+  const seepage::StepReport& last_report() const { return last_report_; }
 
  private:
   void apply_solid_state();
@@ -67,6 +68,7 @@ class SeepageParticipant final : public Participant {
   std::vector<double> lambda0_;  // the scene's conductivity per cell
   Eigen::VectorXd occupancy_, stress_, damage_;
   seepage::Solver::State saved_;
+  seepage::StepReport last_report_;
   int open_cells_ = 0;
 };
 
@@ -85,8 +87,8 @@ class SolidParticipant final : public Participant {
   // Converts total initial stresses to effective: adds alpha p to each
   // particle's normal stresses (before the first step).
   void make_initial_stress_effective();
-  // Called after every MPM step (histories, progress).
-  std::function<void(const mpm::StepInfo&)> on_step;
+  // The last advance: its last MPM step and the particles that left the grid.
+  const mpm::StepInfo& last_window() const { return last_window_; }
 
  private:
   void set_gas_force(double fraction);
@@ -96,7 +98,8 @@ class SolidParticipant final : public Participant {
   const MeshMapping& mapping_;
   double biot_;
   std::optional<double> fixed_time_step_;
-  Eigen::VectorXd pressure_start_, pressure_end_;
+  Eigen::VectorXd pressure_start_, pressure_end_, pressure_now_;
+  mpm::StepInfo last_window_{0};
   mpm::Solver::State saved_;
   Eigen::VectorXd saved_pressure_;
   mutable std::optional<MeshMapping::Averages> averages_;  // of the current state

@@ -82,8 +82,8 @@ int run(const RunOptions& options, scene::Document& doc) {
     const double window = std::min(cs.window, target - coupler.time());
     const auto& r = coupler.advance(window);
     iterations += r.iterations;
-    solid_out.history(solid, mpm::StepInfo{window, 0});
-    seepage_out.history(seepage_solver, window, seepage::StepReport{});
+    solid_out.history(solid, solid_side.last_window());
+    seepage_out.history(seepage_solver, window, seepage_side.last_report());
     log.write(coupler.records().size(), r, seepage_side.open_cells(), seepage_solver.balance().total_outflow(),
               solid.energies().kinetic, solid.particles().size());
     progress.update(static_cast<long>(coupler.records().size()), coupler.time(), window,

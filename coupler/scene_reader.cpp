@@ -1,5 +1,7 @@
 #include "coupler/scene_reader.hpp"
 
+#include <fmt/format.h>
+
 #include "common/units.hpp"
 
 namespace outburst::coupling {
@@ -20,76 +22,83 @@ CouplingSetup read_coupling(const scene::Table& c) {
   s.window = c.quantity({"window", "coupling window: one seepage step, many MPM steps", "", Range::positive()},
                         units::time);
   sc.to_second = {"pressure"};
+
+  // Defaults are the settings structs' own, written here as a scene would.
+  const SchemeSettings scheme_default;
+  const AccelerationSettings acceleration_default;
+  const GasSolidSettings gas_default;
+  const auto text = [](double v) { return fmt::format("{:g}", v); };
+
   // The keys of the iterated schemes are read whatever the scheme, so that one
-  // scene can be swept over schemes (--set coupling.scheme=...).
-  {
-    // One relative measure for every field, and absolute floors for fields
-    // that start at zero (damage) or may vanish (stress in open space).
-    const double rel = c.number({"tolerance", "implicit: relative convergence of each field the solid sends: |r| <= "
-                                              "tolerance |value|", "1e-3", Range::positive()});
-    const double stress_floor = c.quantity({"stress_floor", "absolute convergence of the stress field (norm over "
-                                                            "cells)", "1 kPa", Range::non_negative()},
-                                           units::pressure);
-    const double fraction_floor = c.number({"fraction_floor", "absolute convergence of occupancy and damage (norm "
-                                                              "over cells)", "1e-6", Range::non_negative()});
-    if (sc.kind != SchemeSettings::Kind::one_way)
-      sc.to_first = {{"occupancy", rel, fraction_floor}, {"stress", rel, stress_floor}, {"damage", rel, fraction_floor}};
-  }
-  {
-    auto& a = sc.acceleration;
-    const std::string acc = c.choice({"acceleration", "implicit: \"iqn_ils\" (quasi-Newton), \"aitken\" or \"constant\" "
-                                                      "(under-relaxation)",
-                                      "iqn_ils"},
-                                     {"iqn_ils", "aitken", "constant"});
-    a.kind = acc == "iqn_ils"  ? AccelerationSettings::Kind::iqn_ils
-             : acc == "aitken" ? AccelerationSettings::Kind::aitken
-                               : AccelerationSettings::Kind::constant;
-    a.relaxation = c.number({"relaxation", "constant: the factor; Aitken and IQN-ILS: that of a window's first "
-                                           "iteration",
-                             "0.5", Range{0.0, 1.0, false, true}});
-    {
-      a.reuse_windows = static_cast<int>(c.integer({"reuse_windows", "past windows whose secant columns IQN-ILS "
-                                                                      "reuses", "8", Range::between(0, 100)}));
-      a.max_columns = static_cast<int>(c.integer({"max_columns", "most secant columns", "100",
-                                                  Range::between(1, 10000)}));
-      a.filter = c.number({"filter", "QR2 filter: drop a column whose new part is below this fraction of it",
-                           "1e-2", Range{0.0, 1.0, false, false}});
-    }
-    sc.min_iterations = static_cast<int>(c.integer({"min_iterations", "sub-iterations at least", "1",
-                                                    Range::between(1, 1000)}));
-    sc.max_iterations = static_cast<int>(c.integer({"max_iterations", "sub-iterations at most", "50",
-                                                    Range::between(1, 10000)}));
-    if (sc.max_iterations < sc.min_iterations) c.fail("max_iterations", "must not be below min_iterations");
-    sc.stop_on_divergence = c.choice({"on_divergence", "a window not converged in max_iterations: \"stop\" the run, "
-                                                       "or \"continue\" with its last iterate (recorded)",
-                                      "stop"},
-                                     {"stop", "continue"}) == "stop";
-  }
+  // scene can be swept over schemes (--set coupling.scheme=...). One relative
+  // measure for every field, and absolute floors for fields that start at
+  // zero (damage) or may vanish (stress in open space).
+  const double rel = c.number({"tolerance", "implicit: relative convergence of each field the solid sends: |r| <= "
+                                            "tolerance |value|",
+                               text(Convergence{}.relative), Range::positive()});
+  const double stress_floor = c.quantity({"stress_floor", "absolute convergence of the stress field (norm over cells)",
+                                          "1 kPa", Range::non_negative()},
+                                         units::pressure);
+  const double fraction_floor = c.number({"fraction_floor", "absolute convergence of occupancy and damage (norm "
+                                                            "over cells)",
+                                          "1e-6", Range::non_negative()});
+  if (sc.kind != SchemeSettings::Kind::one_way)
+    sc.to_first = {{"occupancy", rel, fraction_floor}, {"stress", rel, stress_floor}, {"damage", rel, fraction_floor}};
+
+  auto& a = sc.acceleration;
+  const std::string acc = c.choice({"acceleration", "implicit: \"iqn_ils\" (quasi-Newton), \"aitken\" or "
+                                                    "\"constant\" (under-relaxation)",
+                                    "iqn_ils"},
+                                   {"iqn_ils", "aitken", "constant"});
+  a.kind = acc == "iqn_ils"  ? AccelerationSettings::Kind::iqn_ils
+           : acc == "aitken" ? AccelerationSettings::Kind::aitken
+                             : AccelerationSettings::Kind::constant;
+  a.relaxation = c.number({"relaxation", "constant: the factor; Aitken and IQN-ILS: that of a window's first "
+                                         "iteration",
+                           text(acceleration_default.relaxation), Range{0.0, 1.0, false, true}});
+  a.reuse_windows = static_cast<int>(c.integer({"reuse_windows", "past windows whose secant columns IQN-ILS reuses",
+                                                text(acceleration_default.reuse_windows), Range::between(0, 100)}));
+  a.max_columns = static_cast<int>(c.integer({"max_columns", "most secant columns of IQN-ILS",
+                                              text(acceleration_default.max_columns), Range::between(1, 10000)}));
+  a.filter = c.number({"filter", "IQN-ILS QR2 filter: drop a column whose new part is below this fraction of it",
+                       text(acceleration_default.filter), Range{0.0, 1.0, false, false}});
+  sc.min_iterations = static_cast<int>(c.integer({"min_iterations", "sub-iterations at least",
+                                                  text(scheme_default.min_iterations), Range::between(1, 1000)}));
+  sc.max_iterations = static_cast<int>(c.integer({"max_iterations", "sub-iterations at most",
+                                                  text(scheme_default.max_iterations), Range::between(1, 10000)}));
+  if (sc.max_iterations < sc.min_iterations) c.fail("max_iterations", "must not be below min_iterations");
+  sc.stop_on_divergence = c.choice({"on_divergence", "a window not converged in max_iterations: \"stop\" the run, "
+                                                     "or \"continue\" with its last iterate (recorded)",
+                                    scheme_default.stop_on_divergence ? "stop" : "continue"},
+                                   {"stop", "continue"}) == "stop";
 
   GasSolidSettings& g = s.gas_solid;
   g.biot = c.number({"biot_coefficient", "alpha: total stress = effective - alpha p I (the paper's pore pressure "
                                          "coefficient)",
-                     "0.5", Range::between(0, 1)});
+                     text(gas_default.biot), Range::between(0, 1)});
   s.total_initial_stress = c.boolean({"total_initial_stress", "the MPM bodies' initial stresses are total: alpha p0 "
                                                               "is added to make them effective",
-                                      "true"});
+                                      CouplingSetup{}.total_initial_stress ? "true" : "false"});
   g.permeability_coupling = c.boolean({"permeability_coupling", "lambda follows stress and damage (paper eqs. 12, "
                                                                 "14); false: the scene's lambda throughout",
-                                       "true"});
+                                       gas_default.permeability_coupling ? "true" : "false"});
   if (const auto p = c.table("permeability", "lambda = lambda0 exp(-beta sigma') f(D)", false)) {
+    const PermeabilityLaw law;
     g.permeability.beta = p->quantity({"beta", "stress sensitivity (the paper's coupling coefficient)",
-                                       "0.2 MPa^-1", Range::non_negative()},
+                                       fmt::format("{:g} MPa^-1", law.beta * 1e6), Range::non_negative()},
                                       units::inverse_pressure);
-    g.permeability.xi = p->number({"xi", "factor for damaged coal, 0 < D < 1 (the paper gives none)", "5",
+    g.permeability.xi = p->number({"xi", "factor for damaged coal, 0 < D < 1 (the paper gives none)", text(law.xi),
                                    Range::at_least(1)});
     g.permeability.xi_full = p->number({"xi_full", "factor for fragmented coal, D = 1 (the paper gives none)",
-                                        "100", Range::at_least(1)});
-    g.permeability.max_exponent = p->number({"max_exponent", "clamp of |beta sigma'|", "10", Range::positive()});
+                                        text(law.xi_full), Range::at_least(1)});
+    g.permeability.max_exponent = p->number({"max_exponent", "clamp of |beta sigma'|", text(law.max_exponent),
+                                             Range::positive()});
   }
   g.open_below = c.number({"open_below", "a seepage cell holding less solid than this volume fraction is open "
                                          "space (tunnel, cavity)",
-                           "0.5", Range{0.0, 1.0, false, false}});
-  g.open_pressure = c.quantity({"open_pressure", "gas pressure of open space", "0.1 MPa", Range::positive()},
+                           text(gas_default.open_below), Range{0.0, 1.0, false, false}});
+  g.open_pressure = c.quantity({"open_pressure", "gas pressure of open space",
+                                fmt::format("{:g} MPa", gas_default.open_pressure * 1e-6), Range::positive()},
                                units::pressure);
   return s;
 }

@@ -176,8 +176,13 @@ void Solver::set_open_nodes(const std::vector<char>& open, double pressure) {
     last_inflow_pressure_.push_back(0.0);
   }
   open_pressure_ = pressure;
-  for (std::size_t i = 0; i < open.size(); ++i)
-    fixed_by_[i] = boundary_fixed_by_[i] < 0 && open[i] ? open_condition : boundary_fixed_by_[i];
+  bool changed = false;
+  for (std::size_t i = 0; i < open.size(); ++i) {
+    const int by = boundary_fixed_by_[i] < 0 && open[i] ? open_condition : boundary_fixed_by_[i];
+    changed = changed || by != fixed_by_[i];
+    fixed_by_[i] = by;
+  }
+  if (!changed) return;  // the coupler calls this every window
   find_dirichlet_entries();
   ++conductivity_version_;  // the Jacobian's rows changed: refactorise
 }
