@@ -20,14 +20,14 @@ void elastic_trial(const Elasticity& e, const Mat<2>& l, double dt, Mat<2>& s, d
   s_zz += dt * e.lame_lambda() * trace;
 }
 
-double LinearElastic::update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const {
+Dissipation LinearElastic::update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const {
   const int n = static_cast<int>(members.size());
 #pragma omp parallel for schedule(static)
   for (int k = 0; k < n; ++k) {
     const int i = members[k];
     elastic_trial(elasticity(), p.velocity_gradient[i], dt, p.stress[i], p.stress_zz[i]);
   }
-  return 0;
+  return {};
 }
 
 std::pair<double, double> DruckerPragerFit::coefficients(Kind kind, double c, double phi) {
@@ -73,10 +73,22 @@ Invariants invariants(const Mat<2>& s, double s_zz) {
 
 }  // namespace
 
-double Material::strain_energy_density(const Mat<2>& s, double s_zz) const {
-  const auto inv = invariants(s, s_zz);
+double Material::compliance_product(const Mat<2>& a, double a_zz, const Mat<2>& b, double b_zz) const {
+  const auto ia = invariants(a, a_zz), ib = invariants(b, b_zz);
   const double g = elasticity_.shear_modulus(), bulk = elasticity_.lame_lambda() + 2.0 / 3.0 * g;
-  return inv.sqrt_j2 * inv.sqrt_j2 / (2 * g) + inv.mean * inv.mean / (2 * bulk);
+  const double deviatoric = ia.deviator.cwiseProduct(ib.deviator).sum() + ia.deviator_zz * ib.deviator_zz;
+  return deviatoric / (2 * g) + ia.mean * ib.mean / bulk;
+}
+
+double Material::strain_energy(const Particles<2>& p, const std::vector<int>& members) const {
+  const int n = static_cast<int>(members.size());
+  double energy = 0;
+#pragma omp parallel for schedule(static) reduction(+ : energy)
+  for (int k = 0; k < n; ++k) {
+    const int i = members[k];
+    energy += 0.5 * p.volume[i] * compliance_product(p.stress[i], p.stress_zz[i], p.stress[i], p.stress_zz[i]);
+  }
+  return energy;
 }
 
 double DruckerPrager::yield(const Mat<2>& s, double s_zz) const {
@@ -116,7 +128,7 @@ double DruckerPrager::return_map(Mat<2>& s, double& s_zz, double* work_density) 
                                work_density);
 }
 
-double DruckerPrager::update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const {
+Dissipation DruckerPrager::update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const {
   const int n = static_cast<int>(members.size());
   // Equivalent plastic strain per unit multiplier: sqrt(2/3 |dg/dsigma|^2).
   const double strain_per_multiplier = std::sqrt(2.0 / 3.0 * (0.5 + alpha_dilation_ * alpha_dilation_ / 3));
@@ -131,7 +143,7 @@ double DruckerPrager::update_stress(Particles<2>& p, const std::vector<int>& mem
     p.plastic_strain[i] += strain_per_multiplier * multiplier;
     dissipated += p.volume[i] * work;
   }
-  return dissipated;
+  return {dissipated, 0};
 }
 
 namespace {
@@ -189,22 +201,31 @@ double ElasticDamage::damage(double previous, const Mat<2>& effective, double ef
   return std::clamp(damage, 0.0, 1.0);
 }
 
-double ElasticDamage::update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const {
+Dissipation ElasticDamage::update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const {
   const int n = static_cast<int>(members.size());
   const double g = elasticity().shear_modulus(), bulk = elasticity().lame_lambda() + 2.0 / 3.0 * g;
-  double dissipated = 0;
-#pragma omp parallel for schedule(static) reduction(+ : dissipated)
+  double plastic = 0, released = 0;
+#pragma omp parallel for schedule(static) reduction(+ : plastic, released)
   for (int k = 0; k < n; ++k) {
     const int i = members[k];
     Mat<2>& effective = p.effective_stress[i];
     double& effective_zz = p.effective_stress_zz[i];
     elastic_trial(elasticity(), p.velocity_gradient[i], dt, effective, effective_zz);
-    const double d = damage(p.damage[i], effective, effective_zz);
+    const double previous = p.damage[i];
+    const double d = damage(previous, effective, effective_zz);
     p.damage[i] = d;
     // The stress acting: open cracks carry no share of tension.
     const Principal pr = principal(effective);
     Mat<2> s = compose(crack(pr.a, 1 - d), crack(pr.b, 1 - d), pr.direction);
     double s_zz = crack(effective_zz, 1 - d);
+    if (d > previous) {
+      // Y dD: the energy the cracks take at the strain they opened at.
+      const Mat<2> before = compose(crack(pr.a, 1 - previous), crack(pr.b, 1 - previous), pr.direction);
+      const double before_zz = crack(effective_zz, 1 - previous);
+      released += 0.5 * p.volume[i] *
+                  (compliance_product(before, before_zz, effective, effective_zz) -
+                   compliance_product(s, s_zz, effective, effective_zz));
+    }
     // Friction bounds compressive states, with the cohesion the cracks leave;
     // tension is the damage law's to soften (a cone there would cap the elastic
     // strain the damage is read from).
@@ -214,7 +235,7 @@ double ElasticDamage::update_stress(Particles<2>& p, const std::vector<int>& mem
             compressive ? drucker_prager_return(alpha_, (1 - d) * k0_, 0.0, g, bulk, s, s_zz, &work) : 0.0;
         multiplier > 0) {
       p.plastic_strain[i] += multiplier / std::sqrt(3.0);  // no dilation: sqrt(2/3 |dg/dsigma|^2) = 1/sqrt(3)
-      dissipated += p.volume[i] * work;
+      plastic += p.volume[i] * work;
       // Carry the return back to the undamaged stress (same principal axes).
       const Principal back = principal(s);
       const double open = d < 1 ? 1 / (1 - d) : 0.0;
@@ -224,7 +245,19 @@ double ElasticDamage::update_stress(Particles<2>& p, const std::vector<int>& mem
     p.stress[i] = s;
     p.stress_zz[i] = s_zz;
   }
-  return dissipated;
+  return {plastic, released};
+}
+
+double ElasticDamage::strain_energy(const Particles<2>& p, const std::vector<int>& members) const {
+  const int n = static_cast<int>(members.size());
+  double energy = 0;
+#pragma omp parallel for schedule(static) reduction(+ : energy)
+  for (int k = 0; k < n; ++k) {
+    const int i = members[k];
+    energy += 0.5 * p.volume[i] *
+              compliance_product(p.stress[i], p.stress_zz[i], p.effective_stress[i], p.effective_stress_zz[i]);
+  }
+  return energy;
 }
 
 }  // namespace outburst::mpm

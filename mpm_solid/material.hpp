@@ -24,6 +24,17 @@ struct Elasticity {
   double p_wave_speed() const;
 };
 
+// Energy a stress update turns into heat and cracks [J per m of depth].
+struct Dissipation {
+  double plastic = 0;  // plastic work
+  double damage = 0;   // strain energy released as damage grows, Y dD
+  Dissipation& operator+=(const Dissipation& o) {
+    plastic += o.plastic;
+    damage += o.damage;
+    return *this;
+  }
+};
+
 class Material {
  public:
   virtual ~Material() = default;
@@ -35,11 +46,15 @@ class Material {
 
   // Update the stresses of particles `members` over a step dt from their
   // velocity gradients (objective: Jaumann rate, paper eqs. 31-33). Returns the
-  // energy dissipated in the step [J per m of depth].
-  virtual double update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const = 0;
+  // energy dissipated in the step.
+  virtual Dissipation update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const = 0;
 
-  // Elastic strain energy density of a stress state [J/m^3].
-  double strain_energy_density(const Mat<2>& stress, double stress_zz) const;
+  // Strain energy stored in particles `members` [J per m of depth].
+  virtual double strain_energy(const Particles<2>& p, const std::vector<int>& members) const;
+
+  // a : C0^-1 : b for two plane-strain stress states (C0 the undamaged
+  // stiffness); half of it with a = b is the elastic strain energy density.
+  double compliance_product(const Mat<2>& a, double a_zz, const Mat<2>& b, double b_zz) const;
 
  private:
   std::string name_;
@@ -50,7 +65,7 @@ class Material {
 class LinearElastic final : public Material {
  public:
   using Material::Material;
-  double update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const override;
+  Dissipation update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const override;
 };
 
 // The elastic trial step shared by the elastic-plastic models: Jaumann-rate
@@ -79,7 +94,7 @@ class DruckerPrager final : public Material {
  public:
   DruckerPrager(std::string name, Elasticity elasticity, double cohesion, double friction_angle,
                 double dilation_angle, DruckerPragerFit::Kind fit);
-  double update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const override;
+  Dissipation update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const override;
 
   double alpha() const { return alpha_; }
   double k() const { return k_; }
@@ -107,6 +122,9 @@ class DruckerPrager final : public Material {
 //    bounded by Drucker-Prager friction with cohesion (1 - D) c: fully damaged
 //    coal is cohesionless, tension-free granular material that still piles up
 //    and rubs.
+// The energy stored is half the acting stress times the strain,
+// sigma : C0^-1 : sigma~ / 2; what damage growth at fixed strain takes from it
+// is booked as dissipated by damage.
 struct DamageParameters {
   double cohesion;          // c [Pa]
   double friction_angle;    // phi [rad]
@@ -118,10 +136,11 @@ struct DamageParameters {
 class ElasticDamage final : public Material {
  public:
   ElasticDamage(std::string name, Elasticity elasticity, DamageParameters damage);
-  double update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const override;
+  Dissipation update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const override;
   // Damage of one particle, given its history value and effective stress.
   double damage(double previous, const Mat<2>& effective, double effective_zz) const;
   const DamageParameters& parameters() const { return parameters_; }
+  double strain_energy(const Particles<2>& p, const std::vector<int>& members) const override;
 
  private:
   DamageParameters parameters_;

@@ -244,8 +244,11 @@ void Solver::smooth_dilatation() {
 }
 
 void Solver::update_stresses(double dt) {
-  for (std::size_t m = 0; m < materials_.size(); ++m)
-    dissipated_.plastic += materials_[m]->update_stress(particles_, members_[m], dt);
+  for (std::size_t m = 0; m < materials_.size(); ++m) {
+    const Dissipation d = materials_[m]->update_stress(particles_, members_[m], dt);
+    dissipated_.plastic += d.plastic;
+    dissipated_.damage += d.damage;
+  }
   auto& p = particles_;
   const int n = static_cast<int>(p.size());
 #pragma omp parallel for schedule(static)
@@ -527,15 +530,15 @@ Energies Solver::energies() const {
   const auto& p = particles_;
   const int n = static_cast<int>(p.size());
   const Vec<2> g = settings_.gravity;
-  double kinetic = 0, strain = 0, gravity = 0;
-#pragma omp parallel for schedule(static) reduction(+ : kinetic, strain, gravity)
+  double kinetic = 0, gravity = 0;
+#pragma omp parallel for schedule(static) reduction(+ : kinetic, gravity)
   for (int i = 0; i < n; ++i) {
     kinetic += 0.5 * p.mass[i] * p.v[i].squaredNorm();
-    strain += p.volume[i] * materials_[p.material[i]]->strain_energy_density(p.stress[i], p.stress_zz[i]);
     gravity -= p.mass[i] * g.dot(p.x[i] - grid_.lower);
   }
+  e.strain = 0;
+  for (std::size_t m = 0; m < materials_.size(); ++m) e.strain += materials_[m]->strain_energy(p, members_[m]);
   e.kinetic = kinetic;
-  e.strain = strain;
   e.gravity = gravity;
   return e;
 }

@@ -79,16 +79,16 @@ class SimulationError : public std::runtime_error {
 // Energies per metre of depth [J/m]. Stored ones are computed from the current
 // state; dissipated and external ones accumulate over the run. With the
 // gravitational potential measured from the grid's lower edge,
-//   kinetic + strain + gravity + plastic + damping + walls - external
+//   kinetic + strain + gravity + plastic + damage + damping + walls - external
 // stays constant but for what the method itself dissipates: the balance error.
 // That holds the grid's velocity projections, including the kinetic energy a
 // wall removes from material moving into it (an inelastic impact, or O(dt)
 // per unit time for material resting on it); `walls` counts friction only.
 struct Energies {
   double kinetic = 0, strain = 0, gravity = 0;
-  double plastic = 0, damping = 0, walls = 0;  // dissipated so far (walls: friction)
-  double external = 0;                         // work of the external forces so far
-  double total() const { return kinetic + strain + gravity + plastic + damping + walls - external; }
+  double plastic = 0, damage = 0, damping = 0, walls = 0;  // dissipated so far (walls: friction)
+  double external = 0;                                     // work of the external forces so far
+  double total() const { return kinetic + strain + gravity + plastic + damage + damping + walls - external; }
 };
 
 struct StepInfo {

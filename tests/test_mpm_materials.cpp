@@ -173,3 +173,40 @@ TEST_CASE("elastic-damage: shear damage weakens toward the friction cone", "[mpm
   CHECK(remaining.yield(p.stress[0], p.stress_zz[0]) <= 1e-6 * 1e6);
   CHECK(p.plastic_strain[0] > 0);
 }
+
+TEST_CASE("elastic-damage: the work done equals the energy stored plus the energy the cracks took",
+          "[mpm][material][damage][energy]") {
+  // Pull in uniaxial strain through damage to full damage, then shear and
+  // compress the fragments: at every step the stress power integrated so far
+  // must match the stored energy plus the damage and plastic dissipation.
+  ElasticDamage m("coal", coal, coal_damage);
+  auto p = one_particle();
+  const std::vector<int> members{0};
+  const auto power = [&](const Mat<2>& l) { return p.volume[0] * p.stress[0].cwiseProduct(l).sum(); };
+  double work = 0;
+  Dissipation dissipated;
+  const auto drive_tracking = [&](const Mat<2>& l, int steps, double dt) {
+    p.velocity_gradient[0] = l;
+    for (int s = 0; s < steps; ++s) {
+      const double before = power(l);
+      dissipated += m.update_stress(p, members, dt);
+      work += 0.5 * (before + power(l)) * dt;
+    }
+  };
+  Mat<2> l = Mat<2>::Zero();
+  l(0, 0) = 1.0;
+  drive_tracking(l, 4000, 6e-5 / 4000);  // partly damaged
+  const double partly = p.damage[0];
+  CHECK(dissipated.damage > 0);
+  CHECK(m.strain_energy(p, members) + dissipated.damage == Approx(work).epsilon(1e-3));
+  drive_tracking(l, 4000, 2e-4 / 4000);  // fully damaged: nothing stored, all released
+  CHECK(p.damage[0] == 1.0);
+  CHECK(m.strain_energy(p, members) == 0.0);
+  CHECK(dissipated.damage == Approx(work).epsilon(1e-3));
+  CAPTURE(partly);
+  // Back into compression with shear: the fragments store and rub.
+  l << -1.0, 0.3, 0.0, 0.2;
+  drive_tracking(l, 4000, 1e-3 / 4000);
+  CHECK(dissipated.plastic > 0);
+  CHECK(m.strain_energy(p, members) + dissipated.damage + dissipated.plastic == Approx(work).epsilon(2e-3));
+}
