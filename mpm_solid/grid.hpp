@@ -34,8 +34,6 @@ struct Grid {
     for (int d = 0; d < Dim; ++d) n *= static_cast<std::size_t>(nodes_along(d));
     return n;
   }
-  // Position in grid units measured from the first (ghost) node.
-  double grid_coordinate(double x, int d) const { return (x - lower[d]) / h + ghost; }
   // Flat index of the node with integer grid coordinates i.
   std::size_t index(const std::array<int, Dim>& i) const {
     std::size_t flat = 0;

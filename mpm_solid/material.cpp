@@ -20,14 +20,35 @@ void elastic_trial(const Elasticity& e, const Mat<2>& l, double dt, Mat<2>& s, d
   s_zz += dt * e.lame_lambda() * trace;
 }
 
-Dissipation LinearElastic::update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const {
+namespace {
+
+// Runs update(i), the stress update of particle i returning what it
+// dissipated, over `members` in parallel, after carrying the particle's
+// deformation gradient and volume over the step: one pass over the particles
+// serves kinematics and constitution.
+template <class Update>
+Dissipation each_member(Particles<2>& p, const std::vector<int>& members, double dt, Update&& update) {
   const int n = static_cast<int>(members.size());
-#pragma omp parallel for schedule(static)
+  double plastic = 0, damage = 0;
+#pragma omp parallel for schedule(static) reduction(+ : plastic, damage)
   for (int k = 0; k < n; ++k) {
     const int i = members[k];
-    elastic_trial(elasticity(), p.velocity_gradient[i], dt, p.stress[i], p.stress_zz[i]);
+    p.deformation[i] = (Mat<2>::Identity() + dt * p.velocity_gradient[i]) * p.deformation[i];
+    p.volume[i] = p.volume0[i] * p.deformation[i].determinant();
+    const Dissipation d = update(i);
+    plastic += d.plastic;
+    damage += d.damage;
   }
-  return {};
+  return {plastic, damage};
+}
+
+}  // namespace
+
+Dissipation LinearElastic::update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const {
+  return each_member(p, members, dt, [&](int i) {
+    elastic_trial(elasticity(), p.velocity_gradient[i], dt, p.stress[i], p.stress_zz[i]);
+    return Dissipation{};
+  });
 }
 
 std::pair<double, double> DruckerPragerFit::coefficients(Kind kind, double c, double phi) {
@@ -129,21 +150,16 @@ double DruckerPrager::return_map(Mat<2>& s, double& s_zz, double* work_density) 
 }
 
 Dissipation DruckerPrager::update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const {
-  const int n = static_cast<int>(members.size());
   // Equivalent plastic strain per unit multiplier: sqrt(2/3 |dg/dsigma|^2).
   const double strain_per_multiplier = std::sqrt(2.0 / 3.0 * (0.5 + alpha_dilation_ * alpha_dilation_ / 3));
-  double dissipated = 0;
-#pragma omp parallel for schedule(static) reduction(+ : dissipated)
-  for (int k = 0; k < n; ++k) {
-    const int i = members[k];
+  return each_member(p, members, dt, [&](int i) {
     elastic_trial(elasticity(), p.velocity_gradient[i], dt, p.stress[i], p.stress_zz[i]);
     double work = 0;
     const double multiplier = return_map(p.stress[i], p.stress_zz[i], &work);
-    if (multiplier == 0) continue;
+    if (multiplier == 0) return Dissipation{};
     p.plastic_strain[i] += strain_per_multiplier * multiplier;
-    dissipated += p.volume[i] * work;
-  }
-  return {dissipated, 0};
+    return Dissipation{p.volume[i] * work, 0};
+  });
 }
 
 namespace {
@@ -202,12 +218,9 @@ double ElasticDamage::damage(double previous, const Mat<2>& effective, double ef
 }
 
 Dissipation ElasticDamage::update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const {
-  const int n = static_cast<int>(members.size());
   const double g = elasticity().shear_modulus(), bulk = elasticity().lame_lambda() + 2.0 / 3.0 * g;
-  double plastic = 0, released = 0;
-#pragma omp parallel for schedule(static) reduction(+ : plastic, released)
-  for (int k = 0; k < n; ++k) {
-    const int i = members[k];
+  return each_member(p, members, dt, [&](int i) {
+    Dissipation dissipated;
     Mat<2>& effective = p.effective_stress[i];
     double& effective_zz = p.effective_stress_zz[i];
     elastic_trial(elasticity(), p.velocity_gradient[i], dt, effective, effective_zz);
@@ -222,9 +235,9 @@ Dissipation ElasticDamage::update_stress(Particles<2>& p, const std::vector<int>
       // Y dD: the energy the cracks take at the strain they opened at.
       const Mat<2> before = compose(crack(pr.a, 1 - previous), crack(pr.b, 1 - previous), pr.direction);
       const double before_zz = crack(effective_zz, 1 - previous);
-      released += 0.5 * p.volume[i] *
-                  (compliance_product(before, before_zz, effective, effective_zz) -
-                   compliance_product(s, s_zz, effective, effective_zz));
+      dissipated.damage = 0.5 * p.volume[i] *
+                          (compliance_product(before, before_zz, effective, effective_zz) -
+                           compliance_product(s, s_zz, effective, effective_zz));
     }
     // Friction bounds compressive states, with the cohesion the cracks leave;
     // tension is the damage law's to soften (a cone there would cap the elastic
@@ -235,7 +248,7 @@ Dissipation ElasticDamage::update_stress(Particles<2>& p, const std::vector<int>
             compressive ? drucker_prager_return(alpha_, (1 - d) * k0_, 0.0, g, bulk, s, s_zz, &work) : 0.0;
         multiplier > 0) {
       p.plastic_strain[i] += multiplier / std::sqrt(3.0);  // no dilation: sqrt(2/3 |dg/dsigma|^2) = 1/sqrt(3)
-      plastic += p.volume[i] * work;
+      dissipated.plastic = p.volume[i] * work;
       // Carry the return back to the undamaged stress (same principal axes).
       const Principal back = principal(s);
       const double open = d < 1 ? 1 / (1 - d) : 0.0;
@@ -244,8 +257,8 @@ Dissipation ElasticDamage::update_stress(Particles<2>& p, const std::vector<int>
     }
     p.stress[i] = s;
     p.stress_zz[i] = s_zz;
-  }
-  return {plastic, released};
+    return dissipated;
+  });
 }
 
 double ElasticDamage::strain_energy(const Particles<2>& p, const std::vector<int>& members) const {

@@ -45,8 +45,9 @@ class Material {
   const Elasticity& elasticity() const { return elasticity_; }
 
   // Update the stresses of particles `members` over a step dt from their
-  // velocity gradients (objective: Jaumann rate, paper eqs. 31-33). Returns the
-  // energy dissipated in the step.
+  // velocity gradients (objective: Jaumann rate, paper eqs. 31-33), and carry
+  // their deformation gradients and volumes over the step. Returns the energy
+  // dissipated in the step.
   virtual Dissipation update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const = 0;
 
   // Strain energy stored in particles `members` [J per m of depth].

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 
 #include <fmt/format.h>
 
@@ -17,32 +18,37 @@ namespace {
 template <class Shape>
 using Stencil2 = Stencil<2, Shape>;
 
-// Adds each thread's private copy into the first and clears the others.
-void reduce(std::vector<std::vector<double>>& parts, std::vector<double>& total) {
-  const std::size_t n = total.size();
-#pragma omp parallel for schedule(static)
-  for (std::size_t i = 0; i < n; ++i) {
-    double sum = 0;
-    for (auto& part : parts) {
-      sum += part[i];
-      part[i] = 0;
-    }
-    total[i] = sum;
-  }
-}
+// Scattering without locks: thread 0 adds straight into the grid field, the
+// others into private copies that gather() adds in afterwards. The field is
+// cleared first; buffer(t) is where thread t writes.
+template <class T>
+struct Scatter {
+  std::vector<std::vector<T>>& others;  // threads 1, 2, ...
+  std::vector<T>& total;
 
-void reduce(std::vector<std::vector<Vec<2>>>& parts, std::vector<Vec<2>>& total) {
-  const std::size_t n = total.size();
-#pragma omp parallel for schedule(static)
-  for (std::size_t i = 0; i < n; ++i) {
-    Vec<2> sum = Vec<2>::Zero();
-    for (auto& part : parts) {
-      sum += part[i];
-      part[i].setZero();
-    }
-    total[i] = sum;
+  static T zero() {
+    if constexpr (std::is_arithmetic_v<T>)
+      return T(0);
+    else
+      return T::Zero();
   }
-}
+  void clear() {
+    const std::size_t n = total.size();
+#pragma omp parallel for schedule(static)
+    for (std::size_t i = 0; i < n; ++i) total[i] = zero();
+  }
+  std::vector<T>& buffer(int t) { return t == 0 ? total : others[static_cast<std::size_t>(t - 1)]; }
+  void gather() {
+    if (others.empty()) return;
+    const std::size_t n = total.size();
+#pragma omp parallel for schedule(static)
+    for (std::size_t i = 0; i < n; ++i)
+      for (auto& part : others) {
+        total[i] += part[i];
+        part[i] = zero();
+      }
+  }
+};
 
 // A wall condition at one node; n is the unit normal pointing into the wall.
 // Friction walls act only on nodes moving into them: the normal velocity is
@@ -79,9 +85,9 @@ Solver::Solver(Grid<2> grid, std::vector<std::unique_ptr<Material>> materials,
   const std::size_t n = grid_.num_nodes();
   mass_.assign(n, 0.0);
   for (auto* v : {&momentum_, &force_, &velocity_, &velocity_new_}) v->assign(n, Vec<2>::Zero());
-  const int threads = omp_get_max_threads();
-  thread_mass_.assign(static_cast<std::size_t>(threads), std::vector<double>(n, 0.0));
-  thread_vector_.assign(static_cast<std::size_t>(threads), std::vector<Vec<2>>(n, Vec<2>::Zero()));
+  threads_ = omp_get_max_threads();
+  thread_mass_.assign(static_cast<std::size_t>(threads_ - 1), std::vector<double>(n, 0.0));
+  thread_vector_.assign(static_cast<std::size_t>(threads_ - 1), std::vector<Vec<2>>(n, Vec<2>::Zero()));
   node_ij_.resize(n);
   for (int j = 0; j < grid_.nodes_along(1); ++j)
     for (int i = 0; i < grid_.nodes_along(0); ++i) node_ij_[grid_.index({i, j})] = {i, j};
@@ -160,10 +166,14 @@ template <class Shape, bool Apic>
 void Solver::scatter_mass_momentum() {
   const auto& p = particles_;
   const int n = static_cast<int>(p.size());
-#pragma omp parallel num_threads(static_cast<int>(thread_mass_.size()))
+  Scatter<double> masses{thread_mass_, mass_};
+  Scatter<Vec<2>> momenta{thread_vector_, momentum_};
+  masses.clear();
+  momenta.clear();
+#pragma omp parallel num_threads(threads_)
   {
-    auto& m = thread_mass_[omp_get_thread_num()];
-    auto& mv = thread_vector_[omp_get_thread_num()];
+    auto& m = masses.buffer(omp_get_thread_num());
+    auto& mv = momenta.buffer(omp_get_thread_num());
     Stencil2<Shape> s;
 #pragma omp for schedule(static)
     for (int i = 0; i < n; ++i) {
@@ -178,8 +188,8 @@ void Solver::scatter_mass_momentum() {
       }
     }
   }
-  reduce(thread_mass_, mass_);
-  reduce(thread_vector_, momentum_);
+  masses.gather();
+  momenta.gather();
   fold_ghosts(&mass_, momentum_);
 }
 
@@ -201,9 +211,13 @@ void Solver::gather_velocity_gradient() {
 #pragma omp for schedule(static)
     for (int i = 0; i < n; ++i) {
       s.compute(grid_, p.x[i], p.half_width[i]);
-      Mat<2> l = Mat<2>::Zero();
-      for (int k = 0; k < s.count; ++k) l += velocity_[s.node[k]] * s.gradient[k].transpose();
-      p.velocity_gradient[i] = l;
+      Vec<2> dx = Vec<2>::Zero(), dy = Vec<2>::Zero();  // d v / dx, d v / dy
+      for (int k = 0; k < s.count; ++k) {
+        const Vec<2>& v = velocity_[s.node[k]];
+        dx += v * s.gradient[0][k];
+        dy += v * s.gradient[1][k];
+      }
+      p.velocity_gradient[i] << dx, dy;
     }
   }
 }
@@ -212,11 +226,13 @@ template <class Shape>
 void Solver::smooth_dilatation() {
   auto& p = particles_;
   const int n = static_cast<int>(p.size());
-  // Scatter V tr(L) and V into the per-thread vector buffers, reduced into
-  // force_, which is free until scatter_forces rebuilds it.
-#pragma omp parallel num_threads(static_cast<int>(thread_mass_.size()))
+  // Scatter V tr(L) and V into force_, which is free until scatter_forces
+  // rebuilds it.
+  Scatter<Vec<2>> sums{thread_vector_, force_};
+  sums.clear();
+#pragma omp parallel num_threads(threads_)
   {
-    auto& weighted = thread_vector_[omp_get_thread_num()];
+    auto& weighted = sums.buffer(omp_get_thread_num());
     Stencil2<Shape> s;
 #pragma omp for schedule(static)
     for (int i = 0; i < n; ++i) {
@@ -225,7 +241,7 @@ void Solver::smooth_dilatation() {
       for (int k = 0; k < s.count; ++k) weighted[s.node[k]] += s.weight[k] * value;
     }
   }
-  reduce(thread_vector_, force_);
+  sums.gather();
 #pragma omp parallel
   {
     Stencil2<Shape> s;
@@ -249,13 +265,6 @@ void Solver::update_stresses(double dt) {
     dissipated_.plastic += d.plastic;
     dissipated_.damage += d.damage;
   }
-  auto& p = particles_;
-  const int n = static_cast<int>(p.size());
-#pragma omp parallel for schedule(static)
-  for (int i = 0; i < n; ++i) {
-    p.deformation[i] = (Mat<2>::Identity() + dt * p.velocity_gradient[i]) * p.deformation[i];
-    p.volume[i] = p.volume0[i] * p.deformation[i].determinant();
-  }
 }
 
 template <class Shape>
@@ -263,19 +272,22 @@ void Solver::scatter_forces() {
   const auto& p = particles_;
   const int n = static_cast<int>(p.size());
   const Vec<2> g = settings_.gravity;
-#pragma omp parallel num_threads(static_cast<int>(thread_mass_.size()))
+  Scatter<Vec<2>> forces{thread_vector_, force_};
+  forces.clear();
+#pragma omp parallel num_threads(threads_)
   {
-    auto& f = thread_vector_[omp_get_thread_num()];
+    auto& f = forces.buffer(omp_get_thread_num());
     Stencil2<Shape> s;
 #pragma omp for schedule(static)
     for (int i = 0; i < n; ++i) {
       s.compute(grid_, p.x[i], p.half_width[i]);
       const Mat<2> vs = p.volume[i] * p.stress[i];
       const Vec<2> body = p.mass[i] * g + p.external_force[i] + p.surface_force[i];
-      for (int k = 0; k < s.count; ++k) f[s.node[k]] += s.weight[k] * body - vs * s.gradient[k];
+      for (int k = 0; k < s.count; ++k)
+        f[s.node[k]] += s.weight[k] * body - vs.col(0) * s.gradient[0][k] - vs.col(1) * s.gradient[1][k];
     }
   }
-  reduce(thread_vector_, force_);
+  forces.gather();
   fold_ghosts(nullptr, force_);
 }
 
@@ -337,7 +349,6 @@ void Solver::fold_ghosts(std::vector<double>* mass, std::vector<Vec<2>>& vectors
 // work done by friction.
 double Solver::apply_walls(std::vector<Vec<2>>& velocity) const {
   const int g = Grid<2>::ghost;
-  const std::size_t n = velocity.size();
   double friction_work = 0;
   // Wall rows first, then ghost rows outward, so that every mirror is final
   // when it is read (thin domains mirror one wall's ghosts in the other's).
@@ -350,14 +361,14 @@ double Solver::apply_walls(std::vector<Vec<2>>& velocity) const {
       const int wall_row = outward < 0 ? g : g + grid_.cells[axis];
       Vec<2> normal = Vec<2>::Zero();
       normal[axis] = outward;
-#pragma omp parallel for schedule(static) reduction(+ : friction_work)
-      for (std::size_t i = 0; i < n; ++i) {
-        const auto& ij = node_ij_[i];
-        if ((ij[axis] - wall_row) * outward != depth) continue;
+      std::array<int, 2> ij{}, mirror{};
+      ij[axis] = wall_row + depth * outward;
+      mirror[axis] = wall_row - depth * outward;
+      for (int k = 0; k < grid_.nodes_along(t); ++k) {
+        ij[t] = mirror[t] = k;
+        const std::size_t i = grid_.index(ij);
         Vec<2>& v = velocity[i];
         if (depth > 0 && wall.type != Wall::Type::friction) {
-          auto mirror = ij;
-          mirror[axis] = wall_row - depth * outward;
           const Vec<2>& m = velocity[grid_.index(mirror)];
           v[axis] = -m[axis];
           v[t] = wall.type == Wall::Type::fixed ? -m[t] : m[t];
@@ -372,12 +383,17 @@ double Solver::apply_walls(std::vector<Vec<2>>& velocity) const {
   return friction_work;
 }
 
-template <class Shape, bool Apic>
+#pragma omp declare reduction(merge : Census : omp_out += omp_in)
+
+// Move means this is the step's last transfer: the particles move right away
+// and are counted (one pass less); otherwise their displacements wait.
+template <class Shape, bool Apic, bool Move>
 void Solver::gather_motion(double dt) {
   auto& p = particles_;
   const int n = static_cast<int>(p.size());
   const double flip = settings_.flip_fraction;
-#pragma omp parallel
+  Census census;
+#pragma omp parallel reduction(merge : census)
   {
     Stencil2<Shape> s;
 #pragma omp for schedule(static)
@@ -396,7 +412,7 @@ void Solver::gather_motion(double dt) {
           dv += s.weight[k] * (velocity_new_[node] - velocity_[node]);
         }
       }
-      displacement_[i] = dt * v_pic;
+      if constexpr (!Move) displacement_[i] = dt * v_pic;
       if constexpr (Apic) {
         // D is diagonal for tensor-product shapes that reproduce linear fields;
         // a particle on a linear-shape node has D = 0 along that axis (and B too).
@@ -406,15 +422,20 @@ void Solver::gather_motion(double dt) {
       } else {
         p.v[i] = flip * (p.v[i] + dv) + (1 - flip) * v_pic;
       }
+      if constexpr (Move) {
+        p.x[i] += dt * v_pic;
+        count(i, dt, census);
+      }
     }
   }
+  if constexpr (Move) census_ = census;
 }
 
 // Every transfer of a step uses the particles' positions at its start; they move
 // at the end.
 template <class Shape, Scheme S, bool Apic>
 void Solver::step_kernel(double dt) {
-  displacement_.resize(particles_.size());
+  if constexpr (S != Scheme::usf) displacement_.resize(particles_.size());
   scatter_mass_momentum<Shape, Apic>();
   grid_velocities();
   if constexpr (S == Scheme::usf) {
@@ -424,7 +445,7 @@ void Solver::step_kernel(double dt) {
   }
   scatter_forces<Shape>();
   grid_update(dt);
-  gather_motion<Shape, Apic>(dt);
+  gather_motion<Shape, Apic, S == Scheme::usf>(dt);
   if constexpr (S == Scheme::musl) {
     // Map the updated particle momentum back and take the velocity gradient of
     // that field: empty-ish nodes no longer carry the grid update's noise.
@@ -436,25 +457,39 @@ void Solver::step_kernel(double dt) {
     gather_velocity_gradient<Shape>();
     if (settings_.smooth_dilatation) smooth_dilatation<Shape>();
     update_stresses(dt);
+    census_ = move_particles(dt);
   }
-  const int n = static_cast<int>(particles_.size());
-#pragma omp parallel for schedule(static)
-  for (int i = 0; i < n; ++i) particles_.x[i] += displacement_[i];
 }
 
-void Solver::remove_escaped(StepInfo& info) {
+// Books a moved particle: the work of its external force (with the new
+// velocity), and whether it went wrong or left.
+void Solver::count(int i, double dt, Census& census) const {
+  const auto& p = particles_;
+  census.external_work += (p.external_force[i] + p.surface_force[i]).dot(p.v[i]) * dt;
+  if (!p.x[i].allFinite() || !p.v[i].allFinite() || !p.stress[i].allFinite())
+    ++census.bad;
+  else if (!grid_.inside(p.x[i]))
+    ++census.escaped;
+  else if (p.v[i].squaredNorm() > wave_speed_squared_[p.material[i]])
+    ++census.runaway;
+}
+
+Census Solver::move_particles(double dt) {
   auto& p = particles_;
   const int n = static_cast<int>(p.size());
-  long bad = 0, escaped = 0, runaway = 0;
-#pragma omp parallel for schedule(static) reduction(+ : bad, escaped, runaway)
+  Census census;
+#pragma omp parallel for schedule(static) reduction(merge : census)
   for (int i = 0; i < n; ++i) {
-    if (!p.x[i].allFinite() || !p.v[i].allFinite() || !p.stress[i].allFinite())
-      ++bad;
-    else if (!grid_.inside(p.x[i]))
-      ++escaped;
-    else if (p.v[i].squaredNorm() > wave_speed_squared_[p.material[i]])
-      ++runaway;
+    p.x[i] += displacement_[i];
+    count(i, dt, census);
   }
+  return census;
+}
+
+void Solver::remove_escaped(const Census& census, StepInfo& info) {
+  auto& p = particles_;
+  const int n = static_cast<int>(p.size());
+  const long bad = census.bad, escaped = census.escaped, runaway = census.runaway;
   // Material outrunning its own P wave is beyond what an explicit step can carry:
   // the energy is exploding. Stop before it turns into NaN.
   if (runaway > 0 && bad == 0)
@@ -489,13 +524,8 @@ void Solver::remove_escaped(StepInfo& info) {
 StepInfo Solver::step(double dt) {
   StepInfo info{dt};
   (this->*kernel_)(dt);
-  double work = 0;
-  const auto& p = particles_;
-  const int count = static_cast<int>(p.size());
-#pragma omp parallel for schedule(static) reduction(+ : work)
-  for (int i = 0; i < count; ++i) work += (p.external_force[i] + p.surface_force[i]).dot(p.v[i]) * dt;
-  dissipated_.external += work;
-  remove_escaped(info);
+  dissipated_.external += census_.external_work;
+  remove_escaped(census_, info);
   time_ += dt;
   ++steps_;
   return info;

@@ -96,6 +96,20 @@ struct StepInfo {
   std::size_t removed = 0;  // particles that left the grid this step
 };
 
+// What the last pass over the particles in a step found: the work of the
+// external forces over the step and the particles that went wrong or left.
+struct Census {
+  double external_work = 0;
+  long bad = 0, escaped = 0, runaway = 0;
+  Census& operator+=(const Census& o) {
+    external_work += o.external_work;
+    bad += o.bad;
+    escaped += o.escaped;
+    runaway += o.runaway;
+    return *this;
+  }
+};
+
 class Solver {
  public:
   Solver(Grid<2> grid, std::vector<std::unique_ptr<Material>> materials, Particles<2> particles,
@@ -146,7 +160,7 @@ class Solver {
   void gather_velocity_gradient();
   template <class Shape>
   void smooth_dilatation();
-  template <class Shape, bool Apic>
+  template <class Shape, bool Apic, bool Move>
   void gather_motion(double dt);
   void grid_velocities();
   void grid_update(double dt);
@@ -154,7 +168,9 @@ class Solver {
   void find_obstacle_nodes();
   void fold_ghosts(std::vector<double>* mass, std::vector<Vec<2>>& vectors) const;
   void update_stresses(double dt);
-  void remove_escaped(StepInfo& info);
+  void count(int i, double dt, Census& census) const;
+  Census move_particles(double dt);
+  void remove_escaped(const Census& census, StepInfo& info);
   void rebuild_material_groups();
 
   Grid<2> grid_;
@@ -170,7 +186,8 @@ class Solver {
   // Grid fields; per-thread copies of the scattered ones avoid locks.
   std::vector<double> mass_;
   std::vector<Vec<2>> momentum_, force_, velocity_, velocity_new_;
-  std::vector<std::vector<double>> thread_mass_;
+  int threads_ = 1;
+  std::vector<std::vector<double>> thread_mass_;     // of threads 1, 2, ...
   std::vector<std::vector<Vec<2>>> thread_vector_;
   std::vector<std::array<int, 2>> node_ij_;  // grid coordinates of each node
   std::vector<Vec<2>> displacement_;         // of each particle over the step
@@ -180,6 +197,7 @@ class Solver {
     std::size_t obstacle;
   };
   std::vector<ObstacleNode> obstacle_nodes_;
+  Census census_;  // of the last step's move
 
   double time_ = 0;
   long steps_ = 0;

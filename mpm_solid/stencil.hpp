@@ -15,7 +15,9 @@ struct Stencil {
 
   std::array<std::size_t, count> node;
   std::array<double, count> weight;
-  std::array<Vec<Dim>, count> gradient;  // d N / d x [1/m]
+  // d N / d x_d [1/m], one array per direction: kernels read them as scalars,
+  // and scalars written as scalars forward to their loads without a stall.
+  std::array<std::array<double, count>, Dim> gradient;
   std::array<Vec<Dim>, count> offset;    // x_node - x_particle [m], only with Offsets
 
   // Returns false when a node of the support lies outside the (ghost-padded) grid.
@@ -23,20 +25,24 @@ struct Stencil {
   bool compute(const Grid<Dim>& g, const Vec<Dim>& x, double half_width) {
     double w[Dim][support], dw[Dim][support], rel[Dim];
     std::array<int, Dim> base;
+    // A product, not a quotient: inlined into a particle loop, 1 / h is
+    // computed once for all particles.
+    const double inv_h = 1.0 / g.h;
     for (int d = 0; d < Dim; ++d) {
-      const double xi = g.grid_coordinate(x[d], d);
+      const double xi = (x[d] - g.lower[d]) * inv_h + Grid<Dim>::ghost;
       base[d] = Shape::eval(xi, half_width, w[d], dw[d]);
       rel[d] = (base[d] - xi) * g.h;
       if (base[d] < 0 || base[d] + support > g.nodes_along(d)) return false;
     }
-    const double inv_h = 1.0 / g.h;
     int k = 0;
     if constexpr (Dim == 2) {
+      const std::size_t first = g.index({base[0], base[1]}), row = static_cast<std::size_t>(g.nodes_along(0));
       for (int j = 0; j < support; ++j)
         for (int i = 0; i < support; ++i, ++k) {
-          node[k] = g.index({base[0] + i, base[1] + j});
+          node[k] = first + j * row + i;
           weight[k] = w[0][i] * w[1][j];
-          gradient[k] = Vec<Dim>(dw[0][i] * w[1][j], w[0][i] * dw[1][j]) * inv_h;
+          gradient[0][k] = dw[0][i] * w[1][j] * inv_h;
+          gradient[1][k] = w[0][i] * dw[1][j] * inv_h;
           if constexpr (Offsets) offset[k] = Vec<Dim>(rel[0] + i * g.h, rel[1] + j * g.h);
         }
     } else {
@@ -45,9 +51,9 @@ struct Stencil {
           for (int i = 0; i < support; ++i, ++k) {
             node[k] = g.index({base[0] + i, base[1] + j, base[2] + l});
             weight[k] = w[0][i] * w[1][j] * w[2][l];
-            gradient[k] = Vec<Dim>(dw[0][i] * w[1][j] * w[2][l], w[0][i] * dw[1][j] * w[2][l],
-                                   w[0][i] * w[1][j] * dw[2][l]) *
-                          inv_h;
+            gradient[0][k] = dw[0][i] * w[1][j] * w[2][l] * inv_h;
+            gradient[1][k] = w[0][i] * dw[1][j] * w[2][l] * inv_h;
+            gradient[2][k] = w[0][i] * w[1][j] * dw[2][l] * inv_h;
             if constexpr (Offsets) offset[k] = Vec<Dim>(rel[0] + i * g.h, rel[1] + j * g.h, rel[2] + l * g.h);
           }
     }
