@@ -103,12 +103,14 @@ SolidParticipant::SolidParticipant(mpm::Solver& solver, const MeshMapping& mappi
     throw std::invalid_argument("solid: the initial pressure does not match the seepage mesh");
 }
 
-void SolidParticipant::make_initial_stress_effective() {
+void SolidParticipant::make_initial_stress_effective(const std::vector<double>& cell_pressure) {
+  if (cell_pressure.size() != mapping_.mesh().num_cells())
+    throw std::invalid_argument("solid: one initial pressure per seepage cell expected");
   const auto& p = solver_.particles();
   std::vector<double> shift(p.size(), 0.0);
   for (std::size_t i = 0; i < p.size(); ++i)
-    if (const auto s = mapping_.sample(pressure_start_, p.x[i])) shift[i] = biot_ * s->value;
-  solver_.add_isotropic_stress(shift);
+    if (const int c = mapping_.cell_of(p.x[i]); c >= 0) shift[i] = biot_ * cell_pressure[static_cast<std::size_t>(c)];
+  solver_.shift_initial_stress(shift);
   averages_.reset();
 }
 
@@ -154,9 +156,11 @@ void SolidParticipant::set_gas_force(double fraction) {
   auto& force = solver_.external_force();
   pressure_now_ = (1 - fraction) * pressure_start_ + fraction * pressure_end_;
   const int n = static_cast<int>(p.size());
+  // Particles leaving the grid renumber the rest: the hints are then only stale.
+  cell_hint_.resize(p.size(), -1);
 #pragma omp parallel for schedule(static)
   for (int i = 0; i < n; ++i) {
-    const auto s = mapping_.sample(pressure_now_, p.x[i]);
+    const auto s = mapping_.sample(pressure_now_, p.x[i], &cell_hint_[i]);
     force[i] = s ? mpm::Vec<2>(-biot_ * p.volume[i] * s->gradient) : mpm::Vec<2>::Zero();
   }
 }

@@ -84,9 +84,12 @@ class SolidParticipant final : public Participant {
   void save() override;
   void restore() override;
 
-  // Converts total initial stresses to effective: adds alpha p to each
-  // particle's normal stresses (before the first step).
-  void make_initial_stress_effective();
+  // Converts total initial stresses to effective: adds alpha p0 to each
+  // particle's normal stresses (before the first step), p0 the initial
+  // pressure of the region of the seepage cell holding it (`cell_pressure`):
+  // nodes between regions (the face, between coal and tunnel) start at a mean,
+  // which is not the pressure in the coal before it is exposed.
+  void make_initial_stress_effective(const std::vector<double>& cell_pressure);
   // The last advance: its last MPM step and the particles that left the grid.
   const mpm::StepInfo& last_window() const { return last_window_; }
 
@@ -99,6 +102,7 @@ class SolidParticipant final : public Participant {
   double biot_;
   std::optional<double> fixed_time_step_;
   Eigen::VectorXd pressure_start_, pressure_end_, pressure_now_;
+  std::vector<int> cell_hint_;  // per particle, the seepage cell it was last found in
   mpm::StepInfo last_window_{0};
   mpm::Solver::State saved_;
   Eigen::VectorXd saved_pressure_;

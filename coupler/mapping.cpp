@@ -7,8 +7,9 @@ MeshMapping::MeshMapping(seepage::Mesh mesh) : mesh_(std::move(mesh)), locator_(
   for (std::size_t c = 0; c < mesh_.num_cells(); ++c) area_[c] = seepage::q1::integrals(mesh_.corners(c)).lumped.sum();
 }
 
-std::optional<MeshMapping::Sample> MeshMapping::sample(const Eigen::VectorXd& nodal, const Eigen::Vector2d& x) const {
-  const auto hit = locator_.locate(x);
+std::optional<MeshMapping::Sample> MeshMapping::sample(const Eigen::VectorXd& nodal, const Eigen::Vector2d& x,
+                                                      int* hint) const {
+  const auto hit = locator_.locate(x, hint);
   if (!hit) return std::nullopt;
   const auto c = static_cast<std::size_t>(hit->cell);
   return seepage::q1::sample(mesh_.corners(c), mesh_.cells[c], nodal, hit->reference);

@@ -33,8 +33,9 @@ class MeshMapping {
   const std::vector<double>& cell_area() const { return area_; }
 
   using Sample = seepage::q1::Sample;
-  // Nodal field and its gradient at x; nullopt outside the mesh.
-  std::optional<Sample> sample(const Eigen::VectorXd& nodal, const Eigen::Vector2d& x) const;
+  // Nodal field and its gradient at x; nullopt outside the mesh. `hint`: the
+  // cell to try first, updated (see CellLocator::locate).
+  std::optional<Sample> sample(const Eigen::VectorXd& nodal, const Eigen::Vector2d& x, int* hint = nullptr) const;
   // The cell holding x, or -1.
   int cell_of(const Eigen::Vector2d& x) const;
 

@@ -33,6 +33,11 @@ int run(const RunOptions& options, scene::Document& doc) {
                solver.particles().size(), setup.grid.cells[0], setup.grid.cells[1], setup.grid.h, stable);
 
   const auto wall_start = std::chrono::steady_clock::now();
+  if (setup.settling.duration > 0) {
+    const double left = solver.settle(setup.settling, setup.fixed_time_step);
+    spdlog::info("settled for {:.3g} s: kinetic energy down to {:.2e} of its peak; supports removed",
+                 setup.settling.duration, left);
+  }
   mpm::Output out(options.output_directory(), run_info("mpm-solid", doc, "SI: m, s, kg, Pa; 2D plane strain, "
                                                                          "per metre of depth"),
                   setup.tracers);

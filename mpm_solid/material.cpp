@@ -173,9 +173,13 @@ struct Principal {
 Principal principal(const Mat<2>& s) {
   const double centre = 0.5 * (s(0, 0) + s(1, 1));
   const double half = 0.5 * (s(0, 0) - s(1, 1));
-  const double radius = std::hypot(half, s(0, 1));
-  const double angle = 0.5 * std::atan2(s(0, 1), half);
-  return {centre + radius, centre - radius, Vec<2>(std::cos(angle), std::sin(angle))};
+  const double radius = std::sqrt(half * half + s(0, 1) * s(0, 1));
+  if (radius == 0) return {centre, centre, Vec<2>(1, 0)};
+  // Half-angle formulas from cos 2t = half / radius, sin 2t = s_xy / radius:
+  // no trigonometric calls in the innermost loop of the damage law.
+  const double cos2 = half / radius;
+  const double c = std::sqrt(0.5 * (1 + cos2)), sn = std::copysign(std::sqrt(0.5 * (1 - cos2)), s(0, 1));
+  return {centre + radius, centre - radius, Vec<2>(c, sn)};
 }
 
 Mat<2> compose(double a, double b, const Vec<2>& direction) {
@@ -192,6 +196,9 @@ ElasticDamage::ElasticDamage(std::string name, Elasticity elasticity, DamagePara
     : Material(std::move(name), elasticity), parameters_(damage) {
   std::tie(alpha_, k0_) =
       DruckerPragerFit::coefficients(DruckerPragerFit::Kind::outer, damage.cohesion, damage.friction_angle);
+  sin_phi_ = std::sin(damage.friction_angle);
+  cos_phi_ = std::cos(damage.friction_angle);
+  ucs_ = 2 * damage.cohesion * cos_phi_ / (1 - sin_phi_);
 }
 
 double ElasticDamage::damage(double previous, const Mat<2>& effective, double effective_zz) const {
@@ -208,11 +215,9 @@ double ElasticDamage::damage(double previous, const Mat<2>& effective, double ef
         eps1 >= d.ultimate_ratio * eps_t0 ? 1.0 : 1 - d.residual_ratio * d.tensile_strength / (e0 * eps1);
     damage = std::max(damage, tensile);
   }
-  const double sin_phi = std::sin(d.friction_angle), cos_phi = std::cos(d.friction_angle);
-  if (0.5 * (s1 - s3) >= d.cohesion * cos_phi - 0.5 * (s1 + s3) * sin_phi) {
+  if (0.5 * (s1 - s3) >= d.cohesion * cos_phi_ - 0.5 * (s1 + s3) * sin_phi_) {
     const double eps3 = strain(s3, s1, s2);
-    const double ucs = 2 * d.cohesion * cos_phi / (1 - sin_phi);
-    if (eps3 < 0) damage = std::max(damage, 1 - d.residual_ratio * ucs / (e0 * -eps3));
+    if (eps3 < 0) damage = std::max(damage, 1 - d.residual_ratio * ucs_ / (e0 * -eps3));
   }
   return std::clamp(damage, 0.0, 1.0);
 }
@@ -257,6 +262,7 @@ Dissipation ElasticDamage::update_stress(Particles<2>& p, const std::vector<int>
     }
     p.stress[i] = s;
     p.stress_zz[i] = s_zz;
+    if (d >= 1) p.volume[i] = std::min(p.volume[i], parameters_.bulking_factor * p.volume0[i]);
     return dissipated;
   });
 }

@@ -132,6 +132,12 @@ struct DamageParameters {
   double tensile_strength;  // f_t [Pa]
   double residual_ratio;    // f_tr / f_t = f_cr / f_c
   double ultimate_ratio;    // eta = eps_tu / eps_t0
+  // Largest volume of fully damaged material over its initial volume. Broken
+  // coal bulks to a loose heap; beyond that its fragments part and the gaps are
+  // no part of any particle. Without the cap a fragment's volume grows with
+  // the separation, its density (and the force it exerts per unit mass on
+  // recontact) with it, and the stable step shrinks without bound.
+  double bulking_factor = 1.5;
 };
 
 class ElasticDamage final : public Material {
@@ -146,6 +152,7 @@ class ElasticDamage final : public Material {
  private:
   DamageParameters parameters_;
   double alpha_, k0_;  // Drucker-Prager friction cone (outer fit), intact cohesion
+  double sin_phi_, cos_phi_, ucs_;  // of the Mohr-Coulomb shear criterion
 };
 
 }  // namespace outburst::mpm

@@ -43,7 +43,10 @@ void read_obstacles(const scene::Table& s, Settings& st, const Grid<2>& grid) {
                                       {"fixed", "roller", "friction"});
     const double mu = o.number({"friction_coefficient", "Coulomb coefficient of a \"friction\" contact", "0",
                                 Range::non_negative()});
-    st.obstacles.push_back({lov, hiv, {wall_type(type), type == "friction" ? mu : 0.0}});
+    const bool support = o.boolean({"support", "true: holds the material only during [mpm.settle] (the face "
+                                               "before excavation); the dynamic stage starts without it",
+                                    "false"});
+    st.obstacles.push_back({lov, hiv, {wall_type(type), type == "friction" ? mu : 0.0}, support});
   }
 }
 
@@ -116,7 +119,7 @@ Setup read_setup(const scene::Table& s) {
     st.flip_fraction = s.number({"flip_fraction", "FLIP/PIC blend: 1 pure FLIP, 0 pure PIC", "0.99",
                                  Range::between(0, 1)});
   st.courant = s.number({"courant", "time step as a fraction of the CFL limit h / (c + |v|)", "0.3",
-                         Range{0.0, 1.0, false, true}});
+                         Range::between(0, 1)});
   st.smooth_dilatation = s.choice({"locking_remedy",
                                    "\"nodal_dilatation\": smooth the volumetric strain rate over the nodes "
                                    "(against volumetric locking and pressure checkerboards), or \"none\"",
@@ -156,6 +159,18 @@ Setup read_setup(const scene::Table& s) {
   }
 
   read_obstacles(s, st, gr);
+  if (const auto settle = s.table("settle", "a quasi-static stage before t = 0: in-situ stress and gravity brought "
+                                            "to equilibrium with local damping and the supports in place", false)) {
+    setup.settling.duration = settle->quantity({"time", "length of the stage", "", Range::positive()}, units::time);
+    setup.settling.damping =
+        settle->number({"damping", "Cundall local damping coefficient during the stage", "0.8",
+                        Range::between(0, 1)});
+  } else {
+    for (std::size_t k = 0; k < st.obstacles.size(); ++k)
+      if (st.obstacles[k].support)
+        s.fail(fmt::format("obstacles[{}].support", k),
+               "a support is removed when [mpm.settle] ends; add that section or drop the key");
+  }
 
   std::vector<std::string> names;
   for (const auto& m : s.table_array("materials", "constitutive models, referred to by name")) {
@@ -188,6 +203,10 @@ Setup read_setup(const scene::Table& s) {
       d.ultimate_ratio = m.number({"ultimate_strain_ratio", "eta = ultimate tensile strain / strain at f_t, beyond "
                                                             "which D = 1 (the paper gives none; 5-10 is common)",
                                    "5", Range::at_least(1)});
+      d.bulking_factor = m.number({"bulking_factor", "largest volume of fully damaged coal over its volume at t = 0: "
+                                                     "broken coal bulks to a loose heap, its fragments then part "
+                                                     "(1.3-1.6 is typical of broken coal)",
+                                   "1.5", Range::at_least(1)});
       setup.materials.push_back(std::make_unique<ElasticDamage>(name, e, d));
     } else {
       const double c = m.quantity({"cohesion", "Mohr-Coulomb cohesion c", "", Range::non_negative()}, units::pressure);

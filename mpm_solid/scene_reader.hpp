@@ -18,6 +18,7 @@ struct Setup {
   Settings settings;
   std::optional<double> fixed_time_step;  // [s]; otherwise the CFL step each step
   std::vector<int> tracers;               // particle ids whose histories are written
+  Settling settling;                      // the quasi-static stage before t = 0
 };
 
 Setup read_setup(const scene::Table& mpm);

@@ -120,6 +120,7 @@ Solver::Solver(Grid<2> grid, std::vector<std::unique_ptr<Material>> materials,
 
 void Solver::find_obstacle_nodes() {
   const double tolerance = 1e-9 * grid_.h;
+  obstacle_nodes_.clear();
   for (std::size_t k = 0; k < settings_.obstacles.size(); ++k) {
     const Obstacle& o = settings_.obstacles[k];
     if (!(o.upper.array() > o.lower.array()).all())
@@ -531,18 +532,39 @@ StepInfo Solver::step(double dt) {
   return info;
 }
 
-void Solver::add_isotropic_stress(const std::vector<double>& per_particle) {
-  if (steps_ > 0) throw std::logic_error("add_isotropic_stress: the run has already started");
+void Solver::shift_initial_stress(const std::vector<double>& per_particle) {
+  if (steps_ > 0) throw std::logic_error("shift_initial_stress: the run has already started");
   if (per_particle.size() != particles_.size())
-    throw std::invalid_argument(fmt::format("add_isotropic_stress: {} values for {} particles", per_particle.size(),
+    throw std::invalid_argument(fmt::format("shift_initial_stress: {} values for {} particles", per_particle.size(),
                                             particles_.size()));
   auto& p = particles_;
   for (std::size_t i = 0; i < p.size(); ++i) {
+    const double out_of_plane = 2 * materials_[p.material[i]]->elasticity().poisson_ratio * per_particle[i];
     p.stress[i].diagonal().array() += per_particle[i];
-    p.stress_zz[i] += per_particle[i];
+    p.stress_zz[i] += out_of_plane;
     p.effective_stress[i].diagonal().array() += per_particle[i];
-    p.effective_stress_zz[i] += per_particle[i];
+    p.effective_stress_zz[i] += out_of_plane;
   }
+}
+
+double Solver::settle(const Settling& stage, std::optional<double> fixed_step) {
+  const double scene_damping = settings_.local_damping;
+  settings_.local_damping = stage.damping;
+  double largest = 0, kinetic = 0;
+  while (time_ < stage.duration * (1 - 1e-12)) {
+    step(std::min(fixed_step ? *fixed_step : stable_time_step(), stage.duration - time_));
+    kinetic = energies().kinetic;
+    largest = std::max(largest, kinetic);
+  }
+  settings_.local_damping = scene_damping;
+  std::erase_if(settings_.obstacles, [](const Obstacle& o) { return o.support; });
+  find_obstacle_nodes();
+  for (auto& v : particles_.v) v.setZero();
+  for (auto& b : particles_.affine) b.setZero();
+  time_ = 0;
+  steps_ = 0;
+  dissipated_ = {};
+  return largest > 0 ? kinetic / largest : 0.0;
 }
 
 void Solver::restore_state(const State& s) {

@@ -15,6 +15,7 @@
 
 #include <array>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -38,9 +39,19 @@ struct Wall {
 // support): grid nodes inside it or on its edges take its contact condition,
 // with the normal of the nearest face. Faces on grid lines act exactly there;
 // others act up to a cell inside the obstacle.
+// A support holds material only while it settles (the unexcavated face): the
+// dynamic stage starts without it.
 struct Obstacle {
   Vec<2> lower, upper;
   Wall contact{Wall::Type::friction, 0};
+  bool support = false;
+};
+
+// The quasi-static stage before t = 0: in-situ stress and gravity brought to
+// equilibrium with local damping, supports in place.
+struct Settling {
+  double duration = 0;  // [s]; 0: no stage
+  double damping = 0.8;
 };
 
 struct Settings {
@@ -133,9 +144,11 @@ class Solver {
   // Read access, and the per-particle external force another program sets.
   const Particles<2>& particles() const { return particles_; }
   std::vector<Vec<2>>& external_force() { return particles_.external_force; }
-  // Adds s_p to each particle's normal stresses (in-plane and out-of-plane)
-  // before the first step: alpha p when a coupled scene gives total stresses.
-  void add_isotropic_stress(const std::vector<double>& per_particle);
+  // Adds s_p to each particle's in-plane normal stresses before the first
+  // step (alpha p when a coupled scene gives total stresses), and 2 nu s_p to
+  // the out-of-plane one: the initial state stays one of plane strain, whose
+  // sigma_zz = nu (sigma_xx + sigma_yy) holds for the stress the solid feels.
+  void shift_initial_stress(const std::vector<double>& per_particle);
 
   struct State {
     double time;
@@ -146,6 +159,12 @@ class Solver {
   };
   State save_state() const { return {time_, steps_, removed_, particles_, dissipated_}; }
   void restore_state(const State& s);
+
+  // Runs the quasi-static stage (steps of `fixed_step` or the CFL step), then
+  // starts the dynamic one: supports removed, material at rest, clock and
+  // energy books at zero, local damping back to the scene's. Returns the
+  // kinetic energy left at the end of the stage, relative to its largest.
+  double settle(const Settling& stage, std::optional<double> fixed_step);
 
   Energies energies() const;
 

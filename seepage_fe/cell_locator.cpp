@@ -29,6 +29,8 @@ CellLocator::CellLocator(const Mesh& mesh) : mesh_(mesh) {
       clo = clo.cwiseMin(mesh.nodes[mesh.cells[c][k]]);
       chi = chi.cwiseMax(mesh.nodes[mesh.cells[c][k]]);
     }
+    box_lower_.push_back(clo);
+    box_upper_.push_back(chi);
     const auto index = [&](const Eigen::Vector2d& p, int axis, int n) {
       return std::clamp(static_cast<int>((p[axis] - lower_[axis]) / bucket_size_[axis]), 0, n - 1);
     };
@@ -43,7 +45,10 @@ CellLocator::CellLocator(const Mesh& mesh) : mesh_(mesh) {
   }
 }
 
-std::optional<CellLocator::Hit> CellLocator::locate(const Eigen::Vector2d& point) const {
+std::optional<CellLocator::Hit> CellLocator::locate(const Eigen::Vector2d& point, int* hint) const {
+  if (hint && *hint >= 0 && static_cast<std::size_t>(*hint) < mesh_.num_cells())
+    if (const auto ref = q1::inverse_map(mesh_.corners(static_cast<std::size_t>(*hint)), point))
+      return Hit{*hint, *ref};
   const Eigen::Vector2d rel = (point - lower_).cwiseQuotient(bucket_size_);
   const double tol = 1e-9;
   if (rel.x() < -tol || rel.y() < -tol || rel.x() > nx_ + tol || rel.y() > ny_ + tol)
@@ -51,9 +56,17 @@ std::optional<CellLocator::Hit> CellLocator::locate(const Eigen::Vector2d& point
   const int i = std::clamp(static_cast<int>(rel.x()), 0, nx_ - 1);
   const int j = std::clamp(static_cast<int>(rel.y()), 0, ny_ - 1);
   const int b = j * nx_ + i;
+  const Eigen::Vector2d slack = Eigen::Vector2d::Constant(tol).cwiseProduct(bucket_size_);
   for (int k = bucket_start_[b]; k < bucket_start_[b + 1]; ++k) {
     const int cell = bucket_cells_[k];
-    if (const auto ref = q1::inverse_map(mesh_.corners(static_cast<std::size_t>(cell)), point)) return Hit{cell, *ref};
+    const auto c = static_cast<std::size_t>(cell);
+    if ((point.array() < (box_lower_[c] - slack).array()).any() ||
+        (point.array() > (box_upper_[c] + slack).array()).any())
+      continue;
+    if (const auto ref = q1::inverse_map(mesh_.corners(c), point)) {
+      if (hint) *hint = cell;
+      return Hit{cell, *ref};
+    }
   }
   return std::nullopt;
 }

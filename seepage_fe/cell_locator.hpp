@@ -21,7 +21,9 @@ class CellLocator {
     int cell;
     Eigen::Vector2d reference;  // coordinates in [-1, 1]^2
   };
-  std::optional<Hit> locate(const Eigen::Vector2d& point) const;
+  // `hint`, if given, is a cell to try first (where the point was last time);
+  // it is updated to the cell found. Any hint is safe: a wrong one costs one test.
+  std::optional<Hit> locate(const Eigen::Vector2d& point, int* hint = nullptr) const;
 
  private:
   const Mesh& mesh_;
@@ -29,6 +31,7 @@ class CellLocator {
   int nx_ = 1, ny_ = 1;
   std::vector<int> bucket_start_;  // CSR layout: cells of bucket b are
   std::vector<int> bucket_cells_;  // bucket_cells_[bucket_start_[b] .. bucket_start_[b+1])
+  std::vector<Eigen::Vector2d> box_lower_, box_upper_;  // bounding box per cell
 };
 
 }  // namespace outburst::seepage

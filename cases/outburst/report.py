@@ -1,0 +1,296 @@
+#!/usr/bin/python3
+"""Figures and report of the outburst case, beside the paper's (section 4.2).
+
+usage: report.py RESULTS_DIR [--face X] [--tunnel-floor Y] [--tunnel-roof Y]
+writes RESULTS_DIR/fig3_pressure.png ... fig9_displacement.png and
+RESULTS_DIR/report.md.
+
+Snapshots are the paper's "steps": the run's output times, five of them picked
+evenly over the run (the paper never states its time step, model-notes
+section 5). Everything is read from the run's own files: particles_*.h5,
+seepage_*.h5, tracers.csv, mpm_history.csv, coupling.csv.
+"""
+import argparse
+import glob
+import os
+import re
+
+import h5py
+import matplotlib
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+from matplotlib.collections import PolyCollection
+import numpy as np
+
+MPA = 1e6
+# The paper's figures (section 4.2) for the table.
+PAPER = {"centre": 2.55, "top": 1.94, "bottom": 1.95, "farthest": 20.0}
+
+
+def times_of(xdmf):
+    with open(xdmf) as f:
+        return [float(t) for t in re.findall(r'Time Value="([^"]+)"', f.read())]
+
+
+def five(n):
+    """Indices of five snapshots spread over n (first after t = 0 to the last)."""
+    if n <= 5:
+        return list(range(n))
+    return sorted(set(int(round(i)) for i in np.linspace(1, n - 1, 5)))
+
+
+class Run:
+    def __init__(self, d):
+        self.dir = d
+        self.particle_files = sorted(glob.glob(os.path.join(d, "particles_*.h5")))
+        self.seepage_files = sorted(glob.glob(os.path.join(d, "seepage_0*.h5")))
+        self.times = times_of(os.path.join(d, "particles.xdmf"))
+        self.seepage_times = times_of(os.path.join(d, "seepage.xdmf"))
+        with h5py.File(os.path.join(d, "seepage_mesh.h5")) as f:
+            self.nodes = f["nodes"][:, :2]
+            self.cells = f["cells"][:]
+        self.tracers = np.genfromtxt(os.path.join(d, "tracers.csv"), delimiter=",", names=True)
+        self.history = np.genfromtxt(os.path.join(d, "mpm_history.csv"), delimiter=",", names=True)
+        self.coupling = np.genfromtxt(os.path.join(d, "coupling.csv"), delimiter=",", names=True)
+
+    def particles(self, k):
+        with h5py.File(self.particle_files[k]) as f:
+            p = f["particles"]
+            return {name: p[name][:] for name in p.keys() if name != "connectivity"}
+
+    def pressure(self, k):
+        with h5py.File(self.seepage_files[k]) as f:
+            return f["mesh/p"][:]
+
+
+def panel_grid(count, title, size=(11, 2.0)):
+    fig, axes = plt.subplots(count, 1, figsize=(size[0], size[1] * count + 0.6), sharex=True,
+                             constrained_layout=True)
+    fig.suptitle(title)
+    return fig, np.atleast_1d(axes)
+
+
+def draw_rock(ax, face, floor, roof, top):
+    ax.add_patch(plt.Rectangle((0, 0), face, floor, color="0.75", zorder=0))
+    ax.add_patch(plt.Rectangle((0, roof), face, top - roof, color="0.75", zorder=0))
+
+
+def particle_figure(run, picks, field, label, path, geometry, cmap="viridis", vmin=None, vmax=None):
+    fig, axes = panel_grid(len(picks), label)
+    for ax, k in zip(axes, picks):
+        p = run.particles(k)
+        values = field(p)
+        draw_rock(ax, *geometry[:4])
+        sc = ax.scatter(p["points"][:, 0], p["points"][:, 1], c=values, s=1.5, cmap=cmap, vmin=vmin, vmax=vmax,
+                        linewidths=0)
+        ax.set_aspect("equal")
+        ax.set_xlim(0, geometry[4])
+        ax.set_ylim(0, geometry[3])
+        ax.set_title(f"t = {run.times[k]:.3g} s (snapshot {k})", fontsize=9)
+        fig.colorbar(sc, ax=ax, shrink=0.9)
+    axes[-1].set_xlabel("x [m]")
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("results")
+    ap.add_argument("--face", type=float, default=25.0, help="x of the excavation face [m]")
+    ap.add_argument("--tunnel-floor", type=float, default=3.0)
+    ap.add_argument("--tunnel-roof", type=float, default=6.0)
+    ap.add_argument("--top", type=float, default=9.0, help="height of the model [m]")
+    args = ap.parse_args()
+    run = Run(args.results)
+    face, floor, roof, top = args.face, args.tunnel_floor, args.tunnel_roof, args.top
+    width = float(run.nodes[:, 0].max())
+    geometry = (face, floor, roof, top, width)
+    out = lambda name: os.path.join(args.results, name)
+    picks = five(len(run.particle_files))
+    seep_picks = five(len(run.seepage_files))
+
+    # Fig. 3: gas pressure on the seepage mesh.
+    fig, axes = panel_grid(len(seep_picks), "Gas pressure p [MPa] (Fig. 3)")
+    polys = run.nodes[run.cells]
+    for ax, k in zip(axes, seep_picks):
+        p = run.pressure(k) / MPA
+        coll = PolyCollection(polys, array=p[run.cells].mean(axis=1), cmap="jet", edgecolors="none")
+        coll.set_clim(0, 3.0)
+        ax.add_collection(coll)
+        draw_rock(ax, *geometry[:4])
+        ax.set_xlim(0, width)
+        ax.set_ylim(0, top)
+        ax.set_aspect("equal")
+        ax.set_title(f"t = {run.seepage_times[k]:.3g} s", fontsize=9)
+        fig.colorbar(coll, ax=ax, shrink=0.9)
+    axes[-1].set_xlabel("x [m]")
+    fig.savefig(out("fig3_pressure.png"), dpi=130)
+    plt.close(fig)
+
+    # Fig. 4: pressure against distance from the face, along the tunnel's axis.
+    mid = 0.5 * (floor + roof)
+    row = np.where((np.abs(run.nodes[:, 1] - mid) < 1e-6) & (run.nodes[:, 0] >= face - 1e-9))[0]
+    row = row[np.argsort(run.nodes[row, 0])]
+    fig, ax = plt.subplots(figsize=(6.5, 4.2), constrained_layout=True)
+    gradients = []
+    for k in range(len(run.seepage_files)):
+        p = run.pressure(k)[row] / MPA
+        distance = run.nodes[row, 0] - face
+        # The face recedes as coal leaves: the steepest drop along the axis is
+        # where the coal face stands.
+        slope = np.diff(p) / np.diff(distance)
+        steepest = int(np.argmax(slope))
+        gradients.append((run.seepage_times[k], slope[steepest], distance[steepest]))
+        if k in seep_picks or k == 0:
+            ax.plot(distance, p, marker=".", label=f"t = {run.seepage_times[k]:.3g} s")
+    ax.set_xlabel("distance from the excavation face [m]")
+    ax.set_ylabel("gas pressure p [MPa]")
+    ax.set_title(f"Gas pressure along the tunnel axis (y = {mid:g} m) (Fig. 4)")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.savefig(out("fig4_pressure_profile.png"), dpi=130)
+    plt.close(fig)
+
+    # Figs. 5-7: damage, minimum principal stress, speed.
+    particle_figure(run, picks, lambda p: p["damage"].ravel(), "Damage D (Fig. 5)", out("fig5_damage.png"),
+                    geometry, cmap="inferno_r", vmin=0, vmax=1)
+    particle_figure(run, picks, lambda p: p["sigma_min"].ravel() / MPA,
+                    "Minimum principal effective stress [MPa], tension positive (Fig. 6)",
+                    out("fig6_min_principal_stress.png"), geometry, cmap="coolwarm")
+    particle_figure(run, picks, lambda p: np.linalg.norm(p["velocity"], axis=1), "Particle speed [m/s] (Fig. 7)",
+                    out("fig7_velocity.png"), geometry, cmap="turbo")
+
+    # Figs. 8-9: tracers at the top, middle and bottom of the face.
+    names = {0: "particle 1 (top)", 1: "particle 2 (middle)", 2: "particle 3 (bottom)"}
+    tr = run.tracers
+    for column, label, path, title in (
+            ("speed_m_per_s", "speed [m/s]", "fig8_tracer_velocity.png", "Tracer speed (Fig. 8)"),
+            (None, "displacement [m]", "fig9_tracer_displacement.png", "Tracer displacement (Fig. 9)")):
+        fig, ax = plt.subplots(figsize=(6.5, 4.2), constrained_layout=True)
+        for k in range(3):
+            sel = tr["tracer"] == k
+            values = tr[column][sel] if column else np.hypot(tr["ux_m"][sel], tr["uy_m"][sel])
+            ax.plot(tr["time_s"][sel], values, label=names[k])
+        ax.set_xlabel("time [s]")
+        ax.set_ylabel(label)
+        ax.set_title(title)
+        ax.grid(alpha=0.3)
+        ax.legend()
+        fig.savefig(out(path), dpi=130)
+        plt.close(fig)
+
+    write_report(run, args, gradients, out("report.md"))
+
+
+def write_report(run, args, gradients, path):
+    face, floor, roof = args.face, args.tunnel_floor, args.tunnel_roof
+    tr = run.tracers
+    peak = {}
+    for k, name in enumerate(("top", "centre", "bottom")):
+        sel = tr["tracer"] == k
+        i = np.argmax(tr["speed_m_per_s"][sel])
+        peak[name] = (tr["speed_m_per_s"][sel][i], tr["time_s"][sel][i], np.hypot(tr["ux_m"][sel], tr["uy_m"][sel])[-1])
+    last = run.particles(len(run.particle_files) - 1)
+    first = run.particles(0)
+    x0 = first["points"]
+    x = last["points"]
+    ejected = x[:, 0] < face
+    farthest = face - x[:, 0].min() if ejected.any() else 0.0
+    removed = int(run.history["removed_total"][-1])
+    # Where ejection starts: the first snapshot with coal in front of the face.
+    start_time, start_height = None, None
+    for k in range(1, len(run.particle_files)):
+        p = run.particles(k)["points"]
+        out = p[:, 0] < face - 0.1
+        if out.any():
+            start_time = run.times[k]
+            start_height = float(np.median(p[out, 1]))
+            break
+    # Pile: height of the coal above the tunnel floor in 1 m bins in front of the face.
+    bins = np.arange(0, face + 1e-9, 1.0)
+    heights = []
+    for a in bins[:-1]:
+        sel = ejected & (x[:, 0] >= a) & (x[:, 0] < a + 1)
+        heights.append(x[sel, 1].max() - floor if sel.any() else 0.0)
+    # Cavity: seam bins (0.5 m) that held coal at t = 0 and hold less than half
+    # of it now, connected to the face.
+    h = 0.5
+    ex = np.arange(face, 45.0 + 1e-9, h)
+    ey = np.arange(0.0, args.top + 1e-9, h)
+    full0, _, _ = np.histogram2d(x0[:, 0], x0[:, 1], bins=[ex, ey])
+    full1, _, _ = np.histogram2d(x[:, 0], x[:, 1], bins=[ex, ey])
+    emptied = (full0 > 0) & (full1 < 0.5 * full0)
+    cavity = np.zeros_like(emptied)
+    front = [(0, j) for j in range(emptied.shape[1]) if emptied[0, j]]
+    while front:
+        i, j = front.pop()
+        if cavity[i, j]:
+            continue
+        cavity[i, j] = True
+        for a, b in ((i + 1, j), (i - 1, j), (i, j + 1), (i, j - 1)):
+            if 0 <= a < emptied.shape[0] and 0 <= b < emptied.shape[1] and emptied[a, b] and not cavity[a, b]:
+                front.append((a, b))
+    cavity_area = cavity.sum() * h * h
+    cavity_depth = (np.nonzero(cavity.any(axis=1))[0].max() + 1) * h if cavity.any() else 0.0
+    cavity_height = cavity.sum(axis=1).max() * h if cavity.any() else 0.0
+    mouth = cavity[0].sum() * h
+    e = run.history[-1]
+    released = run.coupling["gas_released"][-1]
+    damaged = (last["damage"].ravel() > 0).mean()
+    broken = (last["damage"].ravel() >= 0.99).mean()
+    g = np.array(gradients)
+    lines = [
+        "# Outburst case: measured figures beside the paper's",
+        "",
+        f"Run: `{os.path.abspath(run.dir)}`, {run.times[-1]:.3g} s simulated, "
+        f"{len(x0)} particles, {len(run.cells)} seepage cells.",
+        "",
+        "| quantity | this run | paper |",
+        "|---|---|---|",
+        f"| peak speed, face centre (particle 2) | {peak['centre'][0]:.3g} m/s at {peak['centre'][1]:.3g} s "
+        f"| {PAPER['centre']} m/s |",
+        f"| peak speed, face top (particle 1) | {peak['top'][0]:.3g} m/s at {peak['top'][1]:.3g} s "
+        f"| {PAPER['top']} m/s |",
+        f"| peak speed, face bottom (particle 3) | {peak['bottom'][0]:.3g} m/s at {peak['bottom'][1]:.3g} s "
+        f"| {PAPER['bottom']} m/s |",
+        f"| final displacement top / middle / bottom | {peak['top'][2]:.3g} / {peak['centre'][2]:.3g} / "
+        f"{peak['bottom'][2]:.3g} m | top farthest, then middle, then bottom |",
+        "| ejection starts | " + (f"by t = {start_time:.3g} s, around y = {start_height:.3g} m "
+                                  f"(face {floor:g}-{roof:g} m)" if start_time is not None else "no ejection")
+        + " | mid-face |",
+        f"| farthest coal from the face | {farthest:.3g} m ({removed} particles left the grid at the tunnel's "
+        f"end) | 20 m |",
+        f"| coal in front of the face | {ejected.sum()} particles ({ejected.mean():.1%}) | - |",
+        f"| cavity (seam emptied to < half, connected to the face) | {cavity_area:.3g} m2, {cavity_depth:.3g} m "
+        f"deep, {cavity_height:.3g} m at its highest, mouth {mouth:.3g} m | a large cavity with a small opening |",
+        f"| damaged / fully damaged coal | {damaged:.1%} / {broken:.1%} | damage spreads from the face inward |",
+        f"| gas released into the tunnel | {released:.4g} m3 per m of depth (at the model's pressure) | - |",
+        f"| steepest pressure drop on the tunnel axis | {g[1, 1]:.3g} MPa/m at {g[1, 0]:.3g} s ({g[1, 2]:.3g} m "
+        f"into the seam), {g[-1, 1]:.3g} MPa/m at {g[-1, 0]:.3g} s ({g[-1, 2]:.3g} m) | largest at the face, "
+        "easing with time |",
+        "",
+        "Pile height above the tunnel floor per metre in front of the face (x = 0..1 m first):",
+        "",
+        "    " + " ".join(f"{v:.2f}" for v in heights),
+        "",
+        "## Energy budget (J per m of depth, at the end)",
+        "",
+        "| kinetic | strain | plastic | damage | walls (friction) | gas work | balance error |",
+        "|---|---|---|---|---|---|---|",
+        f"| {e['kinetic_J_per_m']:.4g} | {e['strain_J_per_m']:.4g} | {e['plastic_J_per_m']:.4g} | "
+        f"{e['damage_J_per_m']:.4g} | {e['walls_J_per_m']:.4g} | {e['external_work_J_per_m']:.4g} | "
+        f"{e['balance_error_J_per_m']:.4g} |",
+        "",
+        "The balance error is what the grid takes from particles colliding and separating "
+        "(see mpm_solid/README.md, Energies).",
+        "",
+        "Figures: fig3_pressure.png, fig4_pressure_profile.png, fig5_damage.png, "
+        "fig6_min_principal_stress.png, fig7_velocity.png, fig8_tracer_velocity.png, "
+        "fig9_tracer_displacement.png.",
+    ]
+    with open(path, "w") as f:
+        f.write("\n".join(lines) + "\n")
+
+
+if __name__ == "__main__":
+    main()
