@@ -42,6 +42,16 @@ Dissipation each_member(Particles<2>& p, const std::vector<int>& members, double
   return {plastic, damage};
 }
 
+// Sum of f(i) over the members, in parallel.
+template <class F>
+double sum_over(const std::vector<int>& members, F&& f) {
+  const int n = static_cast<int>(members.size());
+  double sum = 0;
+#pragma omp parallel for schedule(static) reduction(+ : sum)
+  for (int k = 0; k < n; ++k) sum += f(members[k]);
+  return sum;
+}
+
 }  // namespace
 
 Dissipation LinearElastic::update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const {
@@ -102,14 +112,9 @@ double Material::compliance_product(const Mat<2>& a, double a_zz, const Mat<2>& 
 }
 
 double Material::strain_energy(const Particles<2>& p, const std::vector<int>& members) const {
-  const int n = static_cast<int>(members.size());
-  double energy = 0;
-#pragma omp parallel for schedule(static) reduction(+ : energy)
-  for (int k = 0; k < n; ++k) {
-    const int i = members[k];
-    energy += 0.5 * p.volume[i] * compliance_product(p.stress[i], p.stress_zz[i], p.stress[i], p.stress_zz[i]);
-  }
-  return energy;
+  return sum_over(members, [&](int i) {
+    return 0.5 * p.volume[i] * compliance_product(p.stress[i], p.stress_zz[i], p.stress[i], p.stress_zz[i]);
+  });
 }
 
 double DruckerPrager::yield(const Mat<2>& s, double s_zz) const {
@@ -188,7 +193,9 @@ Mat<2> compose(double a, double b, const Vec<2>& direction) {
 }
 
 // Open cracks: tensile principal parts scaled by (1 - D) (or back, by 1/(1 - D)).
-double crack(double principal_value, double factor) { return principal_value > 0 ? factor * principal_value : principal_value; }
+double crack(double principal_value, double factor) {
+  return principal_value > 0 ? factor * principal_value : principal_value;
+}
 
 }  // namespace
 
@@ -268,15 +275,10 @@ Dissipation ElasticDamage::update_stress(Particles<2>& p, const std::vector<int>
 }
 
 double ElasticDamage::strain_energy(const Particles<2>& p, const std::vector<int>& members) const {
-  const int n = static_cast<int>(members.size());
-  double energy = 0;
-#pragma omp parallel for schedule(static) reduction(+ : energy)
-  for (int k = 0; k < n; ++k) {
-    const int i = members[k];
-    energy += 0.5 * p.volume[i] *
-              compliance_product(p.stress[i], p.stress_zz[i], p.effective_stress[i], p.effective_stress_zz[i]);
-  }
-  return energy;
+  return sum_over(members, [&](int i) {
+    return 0.5 * p.volume[i] *
+           compliance_product(p.stress[i], p.stress_zz[i], p.effective_stress[i], p.effective_stress_zz[i]);
+  });
 }
 
 }  // namespace outburst::mpm

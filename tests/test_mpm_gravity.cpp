@@ -276,3 +276,69 @@ box_max = ["1 m", "1 m"]
                     Catch::Contains("overlap.toml") && Catch::Contains("mpm.bodies[0].box_min") &&
                         Catch::Contains("overlaps obstacle 1"));
 }
+
+TEST_CASE("a settling stage brings a block to rest against its support, and the release lets it go",
+          "[mpm][obstacle][stage]") {
+  // Gravity pulls sideways (-x) a block standing on a frictionless floor
+  // against a roller support. Settling must bring it to rest there; once the
+  // support is gone the block must slide freely: x = -g t^2 / 2 from rest.
+  const double g = 9.81, h = 0.1;
+  const Grid<2> gr = grid(4.0, 1.0, h);
+  Settings s;
+  s.gravity = {-g, 0};
+  s.walls[2] = Wall{Wall::Type::roller};
+  s.obstacles.push_back({{1.0, 0.0}, {1.5, 1.0}, {Wall::Type::roller}, true});
+  Solver solver(gr, elastic({1000, 5e7, 0.3}), block(gr, {1.5, 0}, {2.5, 0.5}, 1000, 2), s);
+  solver.settle({0.3, 0.8}, std::nullopt);
+  // Equilibrium: the support carries the block's weight, sigma_xx growing
+  // linearly from the free end, -rho g L / 2 on average.
+  double mean_sxx = 0;
+  const auto count = static_cast<double>(solver.particles().size());
+  for (const auto& st : solver.particles().stress) mean_sxx += st(0, 0) / count;
+  std::printf("\nsettled: mean sigma_xx %.1f Pa (equilibrium %.1f Pa)\n", mean_sxx, -1000 * g * 1.0 / 2);
+  CHECK(mean_sxx == Approx(-1000 * g * 1.0 / 2).epsilon(0.03));
+  CHECK(solver.time() == 0.0);
+  CHECK(solver.steps() == 0);
+  CHECK(solver.energies().kinetic == 0.0);
+  double rest = 1e9;
+  for (const auto& x : solver.particles().x) rest = std::min(rest, x.x());
+  CHECK(rest > 1.5);  // held by the support, within the elastic squeeze
+  const auto start = solver.particles().x;
+  const double t_end = 0.2;
+  while (solver.time() < t_end) solver.step(std::min(solver.stable_time_step(), t_end - solver.time()));
+  const auto& p = solver.particles();
+  double moved = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) moved += (p.x[i].x() - start[i].x()) / static_cast<double>(p.size());
+  std::printf("\nafter the release: mean displacement %.5f m (free fall %.5f m)\n", moved, -0.5 * g * t_end * t_end);
+  CHECK(moved == Approx(-0.5 * g * t_end * t_end).epsilon(0.02));
+}
+
+TEST_CASE("a support without a settling stage is a scene error", "[mpm][obstacle][scene]") {
+  auto doc = scene::Document::parse(R"toml(
+[scene]
+solvers = ["mpm"]
+end_time = "1 s"
+[mpm.grid]
+size = ["2 m", "2 m"]
+cell_size = "0.5 m"
+[[mpm.obstacles]]
+box_min = ["0 m", "0 m"]
+box_max = ["0.5 m", "2 m"]
+support = true
+[[mpm.materials]]
+name = "rock"
+density = "2000 kg/m3"
+youngs_modulus = "1 GPa"
+poisson_ratio = 0.25
+[[mpm.bodies]]
+material = "rock"
+box_min = ["0.5 m", "0 m"]
+box_max = ["2 m", "1 m"]
+)toml",
+                                    "support.toml");
+  auto root = doc->root();
+  read_scene_header(root);
+  CHECK_THROWS_WITH(read_setup(*root.table("mpm", "", true)),
+                    Catch::Contains("support.toml") && Catch::Contains("obstacles[0].support") &&
+                        Catch::Contains("[mpm.settle]"));
+}

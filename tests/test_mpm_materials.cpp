@@ -210,3 +210,15 @@ TEST_CASE("elastic-damage: the work done equals the energy stored plus the energ
   CHECK(dissipated.plastic > 0);
   CHECK(m.strain_energy(p, members) + dissipated.damage + dissipated.plastic == Approx(work).epsilon(2e-3));
 }
+
+TEST_CASE("elastic-damage: broken coal bulks to its bulking factor and no further", "[mpm][material][damage]") {
+  ElasticDamage m("coal", coal, coal_damage);
+  auto p = one_particle();
+  Mat<2> l = Mat<2>::Zero();
+  l(0, 0) = 1.0;
+  drive(m, p, l, 100, 2e-4 / 100);  // fully damaged
+  REQUIRE(p.damage[0] == 1.0);
+  drive(m, p, l, 100, 1.0 / 100);  // fragments parting: the deformation says 2.7 x the volume
+  CHECK(p.deformation[0].determinant() > 2.5);
+  CHECK(p.volume[0] == Approx(coal_damage.bulking_factor * p.volume0[0]).epsilon(1e-12));
+}
