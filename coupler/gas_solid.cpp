@@ -35,6 +35,9 @@ SeepageParticipant::SeepageParticipant(seepage::Solver& solver, GasSolidSettings
   occupancy_ = Eigen::VectorXd::Ones(nc);
   stress_ = Eigen::VectorXd::Zero(3 * nc);
   damage_ = Eigen::VectorXd::Zero(nc);
+  dilatation_ = Eigen::VectorXd::Zero(nc);
+  if (settings_.biot_storage && solver_.model().law != seepage::Law::linear)
+    throw std::invalid_argument("seepage: Biot storage needs the linear Darcy law (law = \"linear\")");
   // Registers open space with the solver now, so that its balance (and any
   // history written from it) has the slot from the start.
   solver_.set_open_nodes(std::vector<char>(solver_.mesh().num_nodes(), 0), settings_.open_pressure);
@@ -44,6 +47,7 @@ void SeepageParticipant::write(const std::string& field, const Eigen::VectorXd& 
   Eigen::VectorXd* target = field == "occupancy" ? &occupancy_
                             : field == "stress"  ? &stress_
                             : field == "damage"  ? &damage_
+                            : field == "dilatation" && settings_.biot_storage ? &dilatation_
                                                  : nullptr;
   if (!target) unknown_field(name(), field);
   if (values.size() != target->size())
@@ -83,6 +87,12 @@ void SeepageParticipant::apply_solid_state() {
 
 void SeepageParticipant::advance(double window) {
   apply_solid_state();
+  if (settings_.biot_storage) {
+    std::vector<double> source(static_cast<std::size_t>(dilatation_.size()));
+    for (Eigen::Index c = 0; c < dilatation_.size(); ++c)
+      source[static_cast<std::size_t>(c)] = -settings_.biot * dilatation_[c] / window;
+    solver_.set_cell_source(std::move(source));
+  }
   last_report_ = solver_.advance(window);
 }
 
@@ -101,6 +111,14 @@ SolidParticipant::SolidParticipant(mpm::Solver& solver, const MeshMapping& mappi
       pressure_end_(std::move(pressure)) {
   if (pressure_start_.size() != static_cast<Eigen::Index>(mapping_.mesh().num_nodes()))
     throw std::invalid_argument("solid: the initial pressure does not match the seepage mesh");
+  mark_window_start();
+}
+
+void SolidParticipant::mark_window_start() {
+  const auto& p = solver_.particles();
+  const auto ids = std::max_element(p.id.begin(), p.id.end());
+  start_volume_.assign(ids == p.id.end() ? 0 : static_cast<std::size_t>(*ids) + 1, 0.0);
+  for (std::size_t i = 0; i < p.size(); ++i) start_volume_[static_cast<std::size_t>(p.id[i])] = p.volume[i];
 }
 
 void SolidParticipant::make_initial_stress_effective(const std::vector<double>& cell_pressure) {
@@ -125,14 +143,16 @@ void SolidParticipant::write(const std::string& field, const Eigen::VectorXd& va
 void SolidParticipant::compute_averages() const {
   if (averages_) return;
   const auto& p = solver_.particles();
-  std::vector<double> values(4 * p.size());
+  std::vector<double> values(5 * p.size());
   for (std::size_t i = 0; i < p.size(); ++i) {
-    values[4 * i] = p.stress[i](0, 0);
-    values[4 * i + 1] = p.stress[i](1, 1);
-    values[4 * i + 2] = p.stress[i](0, 1);
-    values[4 * i + 3] = p.damage[i];
+    values[5 * i] = p.stress[i](0, 0);
+    values[5 * i + 1] = p.stress[i](1, 1);
+    values[5 * i + 2] = p.stress[i](0, 1);
+    values[5 * i + 3] = p.damage[i];
+    // Volume-weighted, this sums to the volume change over the window.
+    values[5 * i + 4] = (p.volume[i] - start_volume_[static_cast<std::size_t>(p.id[i])]) / p.volume[i];
   }
-  averages_ = mapping_.average(p.x, p.volume, values, 4);
+  averages_ = mapping_.average(p.x, p.volume, values, 5);
 }
 
 Eigen::VectorXd SolidParticipant::read(const std::string& field) const {
@@ -140,12 +160,14 @@ Eigen::VectorXd SolidParticipant::read(const std::string& field) const {
   const auto& a = *averages_;
   const auto nc = static_cast<Eigen::Index>(a.fraction.size());
   if (field == "occupancy") return Eigen::Map<const Eigen::VectorXd>(a.fraction.data(), nc);
-  const Eigen::Map<const Eigen::MatrixXd> mean(a.mean.data(), 4, nc);
+  const Eigen::Map<const Eigen::MatrixXd> mean(a.mean.data(), 5, nc);
   if (field == "stress") {
     const Eigen::MatrixXd top = mean.topRows(3);
     return Eigen::Map<const Eigen::VectorXd>(top.data(), 3 * nc);
   }
   if (field == "damage") return mean.row(3).transpose();
+  if (field == "dilatation")
+    return mean.row(4).transpose().cwiseProduct(Eigen::Map<const Eigen::VectorXd>(a.fraction.data(), nc));
   unknown_field(name(), field);
 }
 
@@ -166,6 +188,7 @@ void SolidParticipant::set_gas_force(double fraction) {
 }
 
 void SolidParticipant::advance(double window) {
+  mark_window_start();
   const double start = solver_.time(), end = start + window;
   last_window_ = {0};
   while (solver_.time() < end - 1e-12 * window) {

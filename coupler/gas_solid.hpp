@@ -14,7 +14,10 @@
 //     interpolates it linearly in time over the window, in space with the Q1
 //     shape functions, at every MPM step.
 //   solid -> seepage: per seepage cell, "occupancy" (solid volume fraction),
-//     "stress" (volume-averaged effective stress xx, yy, xy [Pa]) and "damage".
+//     "stress" (volume-averaged effective stress xx, yy, xy [Pa]) and "damage";
+//     with Biot storage also "dilatation": the particles' volume change over
+//     the window per cell area, which the seepage takes as the source
+//     -alpha dilatation / window (linear Darcy law).
 
 #include <optional>
 #include <vector>
@@ -44,6 +47,7 @@ struct GasSolidSettings {
   bool permeability_coupling = true;  // off: lambda stays the scene's
   double open_below = 0.5;   // a cell with less solid than this fraction is open space
   double open_pressure = 1e5;  // [Pa] of open space
+  bool biot_storage = false;   // the solid's volume change is a seepage source
 };
 
 class SeepageParticipant final : public Participant {
@@ -66,7 +70,7 @@ class SeepageParticipant final : public Participant {
   seepage::Solver& solver_;
   GasSolidSettings settings_;
   std::vector<double> lambda0_;  // the scene's conductivity per cell
-  Eigen::VectorXd occupancy_, stress_, damage_;
+  Eigen::VectorXd occupancy_, stress_, damage_, dilatation_;
   seepage::Solver::State saved_;
   seepage::StepReport last_report_;
   int open_cells_ = 0;
@@ -96,6 +100,7 @@ class SolidParticipant final : public Participant {
  private:
   void set_gas_force(double fraction);
   void compute_averages() const;
+  void mark_window_start();
 
   mpm::Solver& solver_;
   const MeshMapping& mapping_;
@@ -103,6 +108,7 @@ class SolidParticipant final : public Participant {
   std::optional<double> fixed_time_step_;
   Eigen::VectorXd pressure_start_, pressure_end_, pressure_now_;
   std::vector<int> cell_hint_;  // per particle, the seepage cell it was last found in
+  std::vector<double> start_volume_;  // per particle id, at the window's start
   mpm::StepInfo last_window_{0};
   mpm::Solver::State saved_;
   Eigen::VectorXd saved_pressure_;

@@ -7,11 +7,9 @@
 
 #include "common/program.hpp"
 #include "common/progress.hpp"
-#include "coupler/scene_reader.hpp"
+#include "coupler/model.hpp"
 #include "mpm_solid/output.hpp"
-#include "mpm_solid/scene_reader.hpp"
 #include "seepage_fe/output.hpp"
-#include "seepage_fe/scene_reader.hpp"
 
 using namespace outburst;
 
@@ -45,45 +43,25 @@ class WindowLog {
 };
 
 int run(const RunOptions& options, scene::Document& doc) {
-  auto root = doc.root();
-  const SceneHeader header = read_scene_header(root);
-  require_solvers(root, header, {"seepage", "mpm"}, "outburst");
-  if (header.solvers.size() != 2)
-    root.table("scene", "", true)->fail("solvers", "outburst couples \"seepage\" and \"mpm\"; run seepage-fe or "
-                                                   "mpm-solid for one alone");
-  seepage::Setup seep = seepage::read_setup(*root.table("seepage", "the gas seepage solver", true), false);
-  mpm::Setup solid_setup = mpm::read_setup(*root.table("mpm", "the material point solver", true));
-  const coupling::CouplingSetup cs = coupling::read_coupling(*root.table("coupling", "the gas-solid coupling", true));
+  coupling::CoupledSetup setup = coupling::read_coupled_setup(doc.root());
   if (!finish_reading(options, doc)) return 0;
-
-  seepage::Solver seepage_solver(seep.mesh, seep.model, seep.settings);
-  mpm::Solver solid(solid_setup.grid, std::move(solid_setup.materials), std::move(solid_setup.particles),
-                    solid_setup.settings);
-  const coupling::MeshMapping mapping(std::move(seep.mesh));
-  coupling::SeepageParticipant seepage_side(seepage_solver, cs.gas_solid);
-  coupling::SolidParticipant solid_side(solid, mapping, cs.gas_solid.biot, seepage_side.read("pressure"),
-                                        solid_setup.fixed_time_step);
-  if (cs.total_initial_stress) {
-    std::vector<double> cell_pressure;
-    for (const int region : mapping.mesh().cell_region)
-      cell_pressure.push_back(seep.model.materials[static_cast<std::size_t>(region)].initial_pressure);
-    solid_side.make_initial_stress_effective(cell_pressure);
-  }
-  if (solid_setup.settling.duration > 0) {
-    // The gas pressure starts uniform in the coal: no gas force while settling.
-    const double left = solid.settle(solid_setup.settling, solid_setup.fixed_time_step);
+  const SceneHeader header = setup.header;
+  const auto tracers = setup.solid.tracers;
+  coupling::CoupledModel model(std::move(setup));
+  if (const auto left = model.settled())
     spdlog::info("settled for {:.3g} s: kinetic energy down to {:.2e} of its peak; supports removed",
-                 solid_setup.settling.duration, left);
-  }
-  coupling::Coupling coupler(seepage_side, solid_side, cs.scheme);
-  spdlog::info("{}: {} seepage cells, {} particles, window {:.3g} s", header.title, mapping.mesh().num_cells(),
+                 model.setup().solid.settling.duration, *left);
+  auto& seepage_solver = model.seepage();
+  auto& solid = model.solid();
+  const auto& cs = model.setup().coupling;
+  spdlog::info("{}: {} seepage cells, {} particles, window {:.3g} s", header.title, model.mapping().mesh().num_cells(),
                solid.particles().size(), cs.window);
 
   const auto directory = options.output_directory();
   const auto info = run_info("outburst", doc, "SI: m, s, kg, Pa; 2D plane strain, per metre of depth; MPM stresses "
                                               "are effective (total = effective - alpha p I)");
   seepage::Output seepage_out(directory, info, seepage_solver);
-  mpm::Output solid_out(directory, info, solid_setup.tracers);
+  mpm::Output solid_out(directory, info, tracers);
   WindowLog log(directory / "coupling.csv", cs.scheme.to_first);
   seepage_out.snapshot(seepage_solver);
   solid_out.snapshot(solid);
@@ -92,16 +70,16 @@ int run(const RunOptions& options, scene::Document& doc) {
   Progress progress("outburst", 0.0, header.end_time, options.show_progress());
   double next_output = header.output_interval;
   long iterations = 0;
+  const auto& coupler = model.coupling();
   while (coupler.time() < header.end_time * (1 - 1e-12)) {
     const double target = std::min(next_output, header.end_time);
-    const double window = std::min(cs.window, target - coupler.time());
-    const auto& r = coupler.advance(window);
+    const auto& r = model.advance(target);
     iterations += r.iterations;
-    solid_out.history(solid, solid_side.last_window());
-    seepage_out.history(seepage_solver, window, seepage_side.last_report());
-    log.write(coupler.records().size(), r, seepage_side.open_cells(), seepage_solver.balance().total_outflow(),
+    solid_out.history(solid, model.solid_side().last_window());
+    seepage_out.history(seepage_solver, r.size, model.seepage_side().last_report());
+    log.write(coupler.records().size(), r, model.seepage_side().open_cells(), seepage_solver.balance().total_outflow(),
               solid.energies().kinetic, solid.particles().size());
-    progress.update(static_cast<long>(coupler.records().size()), coupler.time(), window,
+    progress.update(static_cast<long>(coupler.records().size()), coupler.time(), r.size,
                     fmt::format("sub-iterations {}", r.iterations));
     if (coupler.time() >= target * (1 - 1e-12)) {
       seepage_out.snapshot(seepage_solver);

@@ -42,8 +42,23 @@ CouplingSetup read_coupling(const scene::Table& c) {
   const double fraction_floor = c.number({"fraction_floor", "absolute convergence of occupancy and damage (norm "
                                                             "over cells)",
                                           "1e-6", Range::non_negative()});
-  if (sc.kind != SchemeSettings::Kind::one_way)
-    sc.to_first = {{"occupancy", rel, fraction_floor}, {"stress", rel, stress_floor}, {"damage", rel, fraction_floor}};
+  GasSolidSettings& g = s.gas_solid;
+  g.biot_storage = c.boolean({"biot_storage", "the solid's volume change feeds the seepage: source -alpha "
+                                              "d(eps_v)/dt (linear Darcy law only; for poroelastic checks)",
+                              gas_default.biot_storage ? "true" : "false"});
+  const double dilatation_floor = c.number({"dilatation_floor", "absolute convergence of the dilatation field "
+                                                                "(volume change per cell area over a window)",
+                                            "1e-12", Range::non_negative()});
+  g.permeability_coupling = c.boolean({"permeability_coupling", "lambda follows stress and damage (paper eqs. 12, "
+                                                                "14); false: the scene's lambda throughout",
+                                       gas_default.permeability_coupling ? "true" : "false"});
+  // Only what the seepage uses crosses over (and is iterated on).
+  if (sc.kind != SchemeSettings::Kind::one_way) {
+    sc.to_first = {{"occupancy", rel, fraction_floor}};
+    if (g.permeability_coupling)
+      sc.to_first.insert(sc.to_first.end(), {{"stress", rel, stress_floor}, {"damage", rel, fraction_floor}});
+    if (g.biot_storage) sc.to_first.push_back({"dilatation", rel, dilatation_floor});
+  }
 
   auto& a = sc.acceleration;
   const std::string acc = c.choice({"acceleration", "implicit: \"iqn_ils\" (quasi-Newton), \"aitken\" or "
@@ -72,16 +87,12 @@ CouplingSetup read_coupling(const scene::Table& c) {
                                     scheme_default.stop_on_divergence ? "stop" : "continue"},
                                    {"stop", "continue"}) == "stop";
 
-  GasSolidSettings& g = s.gas_solid;
   g.biot = c.number({"biot_coefficient", "alpha: total stress = effective - alpha p I (the paper's pore pressure "
                                          "coefficient)",
                      text(gas_default.biot), Range::between(0, 1)});
   s.total_initial_stress = c.boolean({"total_initial_stress", "the MPM bodies' initial stresses are total: alpha p0 "
                                                               "is added to make them effective",
                                       CouplingSetup{}.total_initial_stress ? "true" : "false"});
-  g.permeability_coupling = c.boolean({"permeability_coupling", "lambda follows stress and damage (paper eqs. 12, "
-                                                                "14); false: the scene's lambda throughout",
-                                       gas_default.permeability_coupling ? "true" : "false"});
   if (const auto p = c.table("permeability", "lambda = lambda0 exp(-beta sigma') f(D)", false)) {
     const PermeabilityLaw law;
     g.permeability.beta = p->quantity({"beta", "stress sensitivity (the paper's coupling coefficient)",

@@ -237,6 +237,13 @@ void Solver::set_boundary_values(double t, Eigen::VectorXd& u) const {
                           : open_pressure_);
 }
 
+void Solver::set_cell_source(std::vector<double> per_cell) {
+  if (!per_cell.empty() && per_cell.size() != mesh_.num_cells())
+    throw std::invalid_argument(fmt::format("set_cell_source: {} values for {} cells", per_cell.size(),
+                                            mesh_.num_cells()));
+  cell_source_ = std::move(per_cell);
+}
+
 void Solver::load_vector(double t, Eigen::VectorXd& f) const {
   f.setZero();
   for (const auto& bc : model_.boundary_conditions) {
@@ -248,6 +255,11 @@ void Solver::load_vector(double t, Eigen::VectorXd& f) const {
       f[edge[0]] += q * half;
       f[edge[1]] += q * half;
     }
+  }
+  for (std::size_t c = 0; c < cell_source_.size(); ++c) {
+    if (cell_source_[c] == 0) continue;
+    const Eigen::Vector4d lumped = q1::integrals(mesh_.corners(c)).lumped;
+    for (int a = 0; a < 4; ++a) f[mesh_.cells[c][a]] += cell_source_[c] * lumped[a];
   }
   if (!source_) return;
   for (std::size_t c = 0; c < mesh_.num_cells(); ++c) {

@@ -86,6 +86,10 @@ class Solver {
   void set_conductivity(const std::vector<double>& per_cell);
   const std::vector<double>& conductivity() const { return conductivity_; }
   void set_source(SourceFunction source) { source_ = std::move(source); }
+  // A source per cell, constant over each step, in the units of SourceFunction
+  // (the coupler's Biot storage term -alpha d(eps_v)/dt); added to any
+  // source function. Empty: none.
+  void set_cell_source(std::vector<double> per_cell);
   // Nodes touching open space (the tunnel, a cavity the coal has left) held at
   // `pressure` [Pa], on top of the scene's pressure boundaries; the gas they
   // take is booked as outflow to "open space". Replaces the previous set.
@@ -169,6 +173,7 @@ class Solver {
   } factor_key_;
 
   SourceFunction source_;
+  std::vector<double> cell_source_;
 
   // State.
   double time_ = 0;

@@ -1,0 +1,48 @@
+#include "coupler/model.hpp"
+
+namespace outburst::coupling {
+
+CoupledSetup read_coupled_setup(scene::Table root) {
+  CoupledSetup s;
+  s.header = read_scene_header(root);
+  require_solvers(root, s.header, {"seepage", "mpm"}, "outburst");
+  if (s.header.solvers.size() != 2)
+    root.table("scene", "", true)->fail("solvers", "outburst couples \"seepage\" and \"mpm\"; run seepage-fe or "
+                                                   "mpm-solid for one alone");
+  s.seepage = seepage::read_setup(*root.table("seepage", "the gas seepage solver", true), false);
+  s.solid = mpm::read_setup(*root.table("mpm", "the material point solver", true));
+  const auto coupling = root.table("coupling", "the gas-solid coupling", true);
+  s.coupling = read_coupling(*coupling);
+  if (s.coupling.gas_solid.biot_storage && s.seepage.model.law != seepage::Law::linear)
+    coupling->fail("biot_storage", "the Biot storage term is written for the linear Darcy law: set seepage.law = "
+                                   "\"linear\" or drop the key");
+  return s;
+}
+
+CoupledModel::CoupledModel(CoupledSetup setup) : setup_(std::move(setup)) {
+  auto& seep = setup_.seepage;
+  auto& solid = setup_.solid;
+  const CouplingSetup& cs = setup_.coupling;
+  seepage_ = std::make_unique<seepage::Solver>(seep.mesh, seep.model, seep.settings);
+  solid_ = std::make_unique<mpm::Solver>(solid.grid, std::move(solid.materials), std::move(solid.particles),
+                                         solid.settings);
+  mapping_ = std::make_unique<MeshMapping>(seep.mesh);
+  seepage_side_ = std::make_unique<SeepageParticipant>(*seepage_, cs.gas_solid);
+  solid_side_ = std::make_unique<SolidParticipant>(*solid_, *mapping_, cs.gas_solid.biot,
+                                                   seepage_side_->read("pressure"), solid.fixed_time_step);
+  if (cs.total_initial_stress) {
+    std::vector<double> cell_pressure;
+    for (const int region : mapping_->mesh().cell_region)
+      cell_pressure.push_back(seep.model.materials[static_cast<std::size_t>(region)].initial_pressure);
+    solid_side_->make_initial_stress_effective(cell_pressure);
+  }
+  // The gas pressure starts uniform in each region: no gas force while settling.
+  if (solid.settling.duration > 0) settled_ = solid_->settle(solid.settling, solid.fixed_time_step);
+  coupling_ = std::make_unique<Coupling>(*seepage_side_, *solid_side_, cs.scheme);
+}
+
+const WindowRecord& CoupledModel::advance(double limit) {
+  return coupling_->advance(std::min(setup_.coupling.window, limit - coupling_->time()));
+}
+
+}  // namespace outburst::coupling

@@ -1,0 +1,60 @@
+#pragma once
+// A coupled gas-solid model assembled from a scene: both solvers, the mapping
+// between them, their participants and the coupling, in the order the
+// coupling needs (total initial stresses made effective, then the solid's
+// settling stage). The `outburst` program and the tests build it alike.
+
+#include <memory>
+#include <optional>
+
+#include "common/program.hpp"
+#include "coupler/coupling.hpp"
+#include "coupler/gas_solid.hpp"
+#include "coupler/mapping.hpp"
+#include "coupler/scene_reader.hpp"
+#include "mpm_solid/scene_reader.hpp"
+#include "seepage_fe/scene_reader.hpp"
+
+namespace outburst::coupling {
+
+// Everything a coupled scene says, read and checked.
+struct CoupledSetup {
+  SceneHeader header;
+  seepage::Setup seepage;
+  mpm::Setup solid;
+  CouplingSetup coupling;
+};
+
+// Reads [scene], [seepage], [mpm] and [coupling] (the caller then rejects
+// unused keys).
+CoupledSetup read_coupled_setup(scene::Table root);
+
+class CoupledModel {
+ public:
+  explicit CoupledModel(CoupledSetup setup);
+
+  // One coupling window, cut short at `limit`.
+  const WindowRecord& advance(double limit);
+
+  const CoupledSetup& setup() const { return setup_; }
+  seepage::Solver& seepage() { return *seepage_; }
+  mpm::Solver& solid() { return *solid_; }
+  const MeshMapping& mapping() const { return *mapping_; }
+  const SeepageParticipant& seepage_side() const { return *seepage_side_; }
+  const SolidParticipant& solid_side() const { return *solid_side_; }
+  const Coupling& coupling() const { return *coupling_; }
+  // Kinetic energy left by the settling stage over its peak (nullopt: no stage).
+  std::optional<double> settled() const { return settled_; }
+
+ private:
+  CoupledSetup setup_;
+  std::unique_ptr<seepage::Solver> seepage_;
+  std::unique_ptr<mpm::Solver> solid_;
+  std::unique_ptr<MeshMapping> mapping_;
+  std::unique_ptr<SeepageParticipant> seepage_side_;
+  std::unique_ptr<SolidParticipant> solid_side_;
+  std::unique_ptr<Coupling> coupling_;
+  std::optional<double> settled_;
+};
+
+}  // namespace outburst::coupling
