@@ -38,6 +38,10 @@ SeepageParticipant::SeepageParticipant(seepage::Solver& solver, GasSolidSettings
   dilatation_ = Eigen::VectorXd::Zero(nc);
   if (settings_.biot_storage && solver_.model().law != seepage::Law::linear)
     throw std::invalid_argument("seepage: Biot storage needs the linear Darcy law (law = \"linear\")");
+  if (settings_.fixed_stress > 0) {
+    if (!settings_.biot_storage) throw std::invalid_argument("seepage: the fixed-stress split needs Biot storage");
+    solver_.add_storage(settings_.fixed_stress);
+  }
   // Registers open space with the solver now, so that its balance (and any
   // history written from it) has the slot from the start.
   solver_.set_open_nodes(std::vector<char>(solver_.mesh().num_nodes(), 0), settings_.open_pressure);
@@ -87,13 +91,24 @@ void SeepageParticipant::apply_solid_state() {
 
 void SeepageParticipant::advance(double window) {
   apply_solid_state();
+  const Eigen::VectorXd start = read("pressure");
   if (settings_.biot_storage) {
-    std::vector<double> source(static_cast<std::size_t>(dilatation_.size()));
-    for (Eigen::Index c = 0; c < dilatation_.size(); ++c)
-      source[static_cast<std::size_t>(c)] = -settings_.biot * dilatation_[c] / window;
+    // Rates over the solid's last window, which matched the seepage's last.
+    const auto& mesh = solver_.mesh();
+    std::vector<double> source(static_cast<std::size_t>(dilatation_.size()), 0.0);
+    if (last_size_ > 0)
+      for (std::size_t c = 0; c < source.size(); ++c) {
+        double pressure_rate = 0;
+        for (int node : mesh.cells[c]) pressure_rate += 0.25 * (last_end_[node] - last_start_[node]) / last_size_;
+        source[c] = -settings_.biot * dilatation_[static_cast<Eigen::Index>(c)] / last_size_ +
+                    settings_.fixed_stress * pressure_rate;
+      }
     solver_.set_cell_source(std::move(source));
   }
   last_report_ = solver_.advance(window);
+  last_start_ = start;
+  last_end_ = read("pressure");
+  last_size_ = window;
 }
 
 void SeepageParticipant::save() { saved_ = solver_.save_state(); }

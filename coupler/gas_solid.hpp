@@ -48,6 +48,12 @@ struct GasSolidSettings {
   double open_below = 0.5;   // a cell with less solid than this fraction is open space
   double open_pressure = 1e5;  // [Pa] of open space
   bool biot_storage = false;   // the solid's volume change is a seepage source
+  // Fixed-stress split (Kim, Tchelepi & Juanes 2011): the seepage carries the
+  // extra storage beta = alpha^2 / K_dr and the source beta dp/dt of the
+  // pressure it last computed, so the staggered scheme is stable and its
+  // iteration a contraction; the two cancel once the window has converged.
+  // [1/Pa]; 0: off.
+  double fixed_stress = 0;
 };
 
 class SeepageParticipant final : public Participant {
@@ -71,6 +77,11 @@ class SeepageParticipant final : public Participant {
   GasSolidSettings settings_;
   std::vector<double> lambda0_;  // the scene's conductivity per cell
   Eigen::VectorXd occupancy_, stress_, damage_, dilatation_;
+  // The pressure the last advance started from and ended at, and its size:
+  // the "old" rates the Biot source uses (the previous iterate of this window,
+  // or the previous window in a one-pass scheme).
+  Eigen::VectorXd last_start_, last_end_;
+  double last_size_ = 0;
   seepage::Solver::State saved_;
   seepage::StepReport last_report_;
   int open_cells_ = 0;

@@ -1,5 +1,8 @@
 #include "coupler/model.hpp"
 
+#include <algorithm>
+#include <limits>
+
 namespace outburst::coupling {
 
 CoupledSetup read_coupled_setup(scene::Table root) {
@@ -27,7 +30,16 @@ CoupledModel::CoupledModel(CoupledSetup setup) : setup_(std::move(setup)) {
   solid_ = std::make_unique<mpm::Solver>(solid.grid, std::move(solid.materials), std::move(solid.particles),
                                          solid.settings);
   mapping_ = std::make_unique<MeshMapping>(seep.mesh);
-  seepage_side_ = std::make_unique<SeepageParticipant>(*seepage_, cs.gas_solid);
+  GasSolidSettings gas_solid = cs.gas_solid;
+  if (cs.fixed_stress_split) {
+    double bulk = std::numeric_limits<double>::infinity();
+    for (const auto& m : solid_->materials()) {
+      const auto& e = m->elasticity();
+      bulk = std::min(bulk, e.lame_lambda() + 2.0 / 3.0 * e.shear_modulus());
+    }
+    gas_solid.fixed_stress = gas_solid.biot * gas_solid.biot / bulk;
+  }
+  seepage_side_ = std::make_unique<SeepageParticipant>(*seepage_, gas_solid);
   solid_side_ = std::make_unique<SolidParticipant>(*solid_, *mapping_, cs.gas_solid.biot,
                                                    seepage_side_->read("pressure"), solid.fixed_time_step);
   if (cs.total_initial_stress) {

@@ -46,6 +46,12 @@ CouplingSetup read_coupling(const scene::Table& c) {
   g.biot_storage = c.boolean({"biot_storage", "the solid's volume change feeds the seepage: source -alpha "
                                               "d(eps_v)/dt (linear Darcy law only; for poroelastic checks)",
                               gas_default.biot_storage ? "true" : "false"});
+  s.fixed_stress_split = c.boolean({"fixed_stress", "with biot_storage: stabilise the split by the fixed-stress "
+                                                   "extra storage alpha^2 / K_dr (K_dr the smallest drained bulk "
+                                                   "modulus of the materials)",
+                                   "false"});
+  if (s.fixed_stress_split && !g.biot_storage)
+    c.fail("fixed_stress", "stabilises the Biot storage coupling: set biot_storage = true or drop the key");
   const double dilatation_floor = c.number({"dilatation_floor", "absolute convergence of the dilatation field "
                                                                 "(volume change per cell area over a window)",
                                             "1e-12", Range::non_negative()});

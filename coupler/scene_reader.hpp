@@ -15,6 +15,9 @@ struct CouplingSetup {
   double window = 0;                 // [s]
   GasSolidSettings gas_solid;
   bool total_initial_stress = true;  // MPM bodies' initial stresses are total: add alpha p0
+  // Fixed-stress split: GasSolidSettings::fixed_stress = alpha^2 / K_dr, K_dr
+  // the smallest drained bulk modulus of the MPM materials.
+  bool fixed_stress_split = false;
 };
 
 CouplingSetup read_coupling(const scene::Table& coupling);

@@ -244,6 +244,19 @@ void Solver::set_cell_source(std::vector<double> per_cell) {
   cell_source_ = std::move(per_cell);
 }
 
+void Solver::add_storage(double per_pressure) {
+  if (steps_ > 0) throw std::logic_error("add_storage: the run has already started");
+  if (model_.law != Law::linear) throw std::invalid_argument("add_storage: only for the linear law");
+  for (std::size_t c = 0; c < mesh_.num_cells(); ++c) {
+    const Eigen::Vector4d lumped = q1::integrals(mesh_.corners(c)).lumped;
+    for (int a = 0; a < 4; ++a) capacity_[mesh_.cells[c][a]] += per_pressure * lumped[a];
+  }
+  balance_.initial_stored = 0;
+  for (Eigen::Index i = 0; i < u_.size(); ++i)
+    balance_.initial_stored += capacity_[i] * storage_x(model_.law, u_[i]);
+  balance_.stored = balance_.initial_stored;
+}
+
 void Solver::load_vector(double t, Eigen::VectorXd& f) const {
   f.setZero();
   for (const auto& bc : model_.boundary_conditions) {

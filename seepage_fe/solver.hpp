@@ -90,6 +90,10 @@ class Solver {
   // (the coupler's Biot storage term -alpha d(eps_v)/dt); added to any
   // source function. Empty: none.
   void set_cell_source(std::vector<double> per_cell);
+  // Adds `per_pressure` [1/Pa] to the storage coefficient everywhere (linear
+  // law, before the first step): the coupler's fixed-stress stabilisation,
+  // whose matching source it supplies itself.
+  void add_storage(double per_pressure);
   // Nodes touching open space (the tunnel, a cavity the coal has left) held at
   // `pressure` [Pa], on top of the scene's pressure boundaries; the gas they
   // take is booked as outflow to "open space". Replaces the previous set.
