@@ -1,0 +1,98 @@
+#!/usr/bin/python3
+"""Sensitivity of the outburst case's headline numbers to the parameters the
+paper does not give, and to resolution.
+
+usage: sensitivity.py [--outburst build/coupler/outburst] [--out results/outburst_sensitivity]
+                      [--end-time "1 s"]
+writes OUT/sensitivity.md and OUT/sensitivity.csv; one run per row (one at a
+time: each uses every core), about 10 minutes on 2 cores.
+"""
+import argparse
+import csv
+import os
+import subprocess
+import time
+
+import h5py
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+FACE = 25.0
+
+# (label, overrides): each row changes one choice of outburst.toml.
+VARIANTS = [
+    ("as shipped", []),
+    ("xi' = 20", ["coupling.permeability.xi_full=20"]),
+    ("xi' = 500", ["coupling.permeability.xi_full=500"]),
+    ("eta = 10", ["mpm.materials[0].ultimate_strain_ratio=10"]),
+    ("residual ratio 0.3", ["mpm.materials[0].residual_ratio=0.3"]),
+    ("floor/roof friction 0.2", ["mpm.obstacles[0].friction_coefficient=0.2",
+                                 "mpm.obstacles[1].friction_coefficient=0.2"]),
+    ("floor/roof friction 0.6", ["mpm.obstacles[0].friction_coefficient=0.6",
+                                 "mpm.obstacles[1].friction_coefficient=0.6"]),
+    ("bulking factor 1.3", ["mpm.materials[0].bulking_factor=1.3"]),
+    ("grid 0.5 m", ['mpm.grid.cell_size="0.5 m"']),
+    ("grid 0.25 m", ['mpm.grid.cell_size="0.25 m"']),
+]
+
+
+def headline(directory):
+    tr = np.genfromtxt(os.path.join(directory, "tracers.csv"), delimiter=",", names=True)
+    speed = {k: tr["speed_m_per_s"][tr["tracer"] == k].max() for k in range(3)}
+    files = sorted(f for f in os.listdir(directory) if f.startswith("particles_") and f.endswith(".h5"))
+    with h5py.File(os.path.join(directory, files[-1])) as f:
+        x = f["particles/points"][:]
+        damage = f["particles/damage"][:].ravel()
+    ejected = x[:, 0] < FACE
+    coupling = np.genfromtxt(os.path.join(directory, "coupling.csv"), delimiter=",", names=True)
+    history = np.genfromtxt(os.path.join(directory, "mpm_history.csv"), delimiter=",", names=True)
+    return {
+        "centre_m_per_s": speed[1], "top_m_per_s": speed[0], "bottom_m_per_s": speed[2],
+        "farthest_m": FACE - x[:, 0].min() if ejected.any() else 0.0,
+        "ejected_fraction": ejected.mean(),
+        "fully_damaged_fraction": (damage >= 0.99).mean(),
+        "gas_released_m3_per_m": coupling["gas_released"][-1],
+        "left_grid": int(history["removed_total"][-1]),
+    }
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--outburst", default="build/coupler/outburst")
+    ap.add_argument("--out", default="results/outburst_sensitivity")
+    ap.add_argument("--end-time", default="1 s")
+    args = ap.parse_args()
+    os.makedirs(args.out, exist_ok=True)
+    rows = []
+    for k, (label, overrides) in enumerate(VARIANTS):
+        run_dir = os.path.join(args.out, f"run_{k:02d}")
+        command = [args.outburst, os.path.join(HERE, "outburst.toml"), "-q", "-o", run_dir,
+                   "--set", f'scene.end_time="{args.end_time}"']
+        for o in overrides:
+            command += ["--set", o]
+        start = time.monotonic()
+        subprocess.run(command, check=True)
+        row = {"variant": label, "wall_s": time.monotonic() - start, **headline(run_dir)}
+        rows.append(row)
+        print(f"{label}: {row}", flush=True)
+    with open(os.path.join(args.out, "sensitivity.csv"), "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
+        w.writeheader()
+        w.writerows(rows)
+    lines = ["# Outburst: sensitivity of the headline numbers", "",
+             f"Each row changes one choice of `cases/outburst/outburst.toml`; {args.end_time} simulated.", "",
+             "| variant | centre / top / bottom peak speed [m/s] | farthest [m] | ejected | fully damaged "
+             "| gas released [m3/m] | left the grid | wall [s] |",
+             "|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        lines.append(f"| {r['variant']} | {r['centre_m_per_s']:.1f} / {r['top_m_per_s']:.1f} / "
+                     f"{r['bottom_m_per_s']:.1f} | {r['farthest_m']:.1f} | {r['ejected_fraction']:.1%} | "
+                     f"{r['fully_damaged_fraction']:.1%} | {r['gas_released_m3_per_m']:.1f} | {r['left_grid']} | "
+                     f"{r['wall_s']:.0f} |")
+    with open(os.path.join(args.out, "sensitivity.md"), "w") as f:
+        f.write("\n".join(lines) + "\n")
+    print("\n".join(lines))
+
+
+if __name__ == "__main__":
+    main()
