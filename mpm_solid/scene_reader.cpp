@@ -128,6 +128,10 @@ Setup read_setup(const scene::Table& s) {
   st.local_damping = s.number({"local_damping",
                                "Cundall local damping coefficient (quasi-static stages; 0: off)", "0",
                                Range::between(0, 1)});
+  st.viscous_damping = s.quantity({"viscous_damping", "mass-proportional damping c, nodal force -c m v (smooth, "
+                                                     "for quasi-static solids in iterated couplings; 0: off)",
+                                   "0 1/s", Range::non_negative()},
+                                  units::rate);
   const auto g = s.quantity_vector({"gravity", "gravitational acceleration", "0 m/s2, 0 m/s2"},
                                    units::acceleration, 2);
   st.gravity = {g[0], g[1]};

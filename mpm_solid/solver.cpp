@@ -306,10 +306,19 @@ void Solver::grid_update(double dt) {
         }
     dissipated_.damping += work;
   }
-#pragma omp parallel for schedule(static)
-  for (std::size_t i = 0; i < n; ++i)
-    velocity_new_[i] = mass_[i] > empty_node_mass_ ? Vec<2>(velocity_[i] + dt * force_[i] / mass_[i])
-                                                   : Vec<2>::Zero();
+  // v_new = (v + dt f / m) / (1 + c dt): the viscous force -c m v_new.
+  const double c = settings_.viscous_damping, shrink = 1 / (1 + c * dt);
+  double viscous_work = 0;
+#pragma omp parallel for schedule(static) reduction(+ : viscous_work)
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!(mass_[i] > empty_node_mass_)) {
+      velocity_new_[i].setZero();
+      continue;
+    }
+    velocity_new_[i] = shrink * (velocity_[i] + dt * force_[i] / mass_[i]);
+    if (c > 0) viscous_work += c * dt * mass_[i] * velocity_new_[i].dot(0.5 * (velocity_[i] + velocity_new_[i]));
+  }
+  dissipated_.damping += viscous_work;
   dissipated_.walls += apply_walls(velocity_new_);
 }
 

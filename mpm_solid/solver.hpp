@@ -69,6 +69,11 @@ struct Settings {
   // Local (Cundall) damping coefficient for quasi-static stages: each nodal
   // force component loses alpha |f| against the node's motion. 0: off.
   double local_damping = 0;
+  // Mass-proportional viscous damping c [1/s]: nodal force -c m v, taken
+  // implicitly (stable for any c). Linear and smooth in the state, unlike the
+  // local damping's sign switch: what an iterated coupling of a quasi-static
+  // solid needs. 0: off.
+  double viscous_damping = 0;
   // left, right, bottom, top of the physical domain
   std::array<Wall, 4> walls;
   std::vector<Obstacle> obstacles;

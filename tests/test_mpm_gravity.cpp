@@ -342,3 +342,24 @@ box_max = ["2 m", "1 m"]
                     Catch::Contains("support.toml") && Catch::Contains("obstacles[0].support") &&
                         Catch::Contains("[mpm.settle]"));
 }
+
+TEST_CASE("viscous damping slows a drifting block as exp(-c t) and books what it takes", "[mpm][damping]") {
+  const double c = 5.0, v0 = 2.0, t_end = 0.2;
+  const Grid<2> gr = grid(4.0, 2.0, 0.1);
+  Settings s;
+  s.viscous_damping = c;
+  auto particles = block(gr, {1.0, 0.5}, {1.5, 1.0}, 1000, 2);
+  for (auto& v : particles.v) v = Vec<2>(v0, 0);
+  Solver solver(gr, elastic({1000, 5e7, 0.3}), std::move(particles), s);
+  const double start = solver.energies().total();
+  while (solver.time() < t_end) solver.step(std::min(solver.stable_time_step(), t_end - solver.time()));
+  const auto& p = solver.particles();
+  double v = 0;
+  for (const auto& vi : p.v) v += vi.x() / static_cast<double>(p.size());
+  const Energies e = solver.energies();
+  std::printf("\nviscous damping: velocity %.5f m/s (exp(-c t) v0 = %.5f), damping %.4g J/m, balance error %.2e of "
+              "the initial kinetic energy\n",
+              v, v0 * std::exp(-c * t_end), e.damping, (e.total() - start) / start);
+  CHECK(v == Approx(v0 * std::exp(-c * t_end)).epsilon(0.01));
+  CHECK(std::abs(e.total() - start) < 1e-2 * start);
+}
