@@ -117,19 +117,22 @@ void SeepageParticipant::restore() { solver_.restore_state(saved_); }
 // ---- solid
 
 SolidParticipant::SolidParticipant(mpm::Solver& solver, const MeshMapping& mapping, double biot,
-                                   Eigen::VectorXd pressure, std::optional<double> fixed_time_step)
+                                   Eigen::VectorXd pressure, std::optional<double> fixed_time_step,
+                                   bool sends_dilatation)
     : solver_(solver),
       mapping_(mapping),
       biot_(biot),
       fixed_time_step_(fixed_time_step),
       pressure_start_(pressure),
-      pressure_end_(std::move(pressure)) {
+      pressure_end_(std::move(pressure)),
+      sends_dilatation_(sends_dilatation) {
   if (pressure_start_.size() != static_cast<Eigen::Index>(mapping_.mesh().num_nodes()))
     throw std::invalid_argument("solid: the initial pressure does not match the seepage mesh");
   mark_window_start();
 }
 
 void SolidParticipant::mark_window_start() {
+  if (!sends_dilatation_) return;
   const auto& p = solver_.particles();
   const auto ids = std::max_element(p.id.begin(), p.id.end());
   start_volume_.assign(ids == p.id.end() ? 0 : static_cast<std::size_t>(*ids) + 1, 0.0);
@@ -158,16 +161,18 @@ void SolidParticipant::write(const std::string& field, const Eigen::VectorXd& va
 void SolidParticipant::compute_averages() const {
   if (averages_) return;
   const auto& p = solver_.particles();
-  std::vector<double> values(5 * p.size());
+  const std::size_t k = sends_dilatation_ ? 5 : 4;
+  std::vector<double> values(k * p.size());
   for (std::size_t i = 0; i < p.size(); ++i) {
-    values[5 * i] = p.stress[i](0, 0);
-    values[5 * i + 1] = p.stress[i](1, 1);
-    values[5 * i + 2] = p.stress[i](0, 1);
-    values[5 * i + 3] = p.damage[i];
+    values[k * i] = p.stress[i](0, 0);
+    values[k * i + 1] = p.stress[i](1, 1);
+    values[k * i + 2] = p.stress[i](0, 1);
+    values[k * i + 3] = p.damage[i];
     // Volume-weighted, this sums to the volume change over the window.
-    values[5 * i + 4] = (p.volume[i] - start_volume_[static_cast<std::size_t>(p.id[i])]) / p.volume[i];
+    if (sends_dilatation_)
+      values[k * i + 4] = (p.volume[i] - start_volume_[static_cast<std::size_t>(p.id[i])]) / p.volume[i];
   }
-  averages_ = mapping_.average(p.x, p.volume, values, 5);
+  averages_ = mapping_.average(p.x, p.volume, values, static_cast<int>(k));
 }
 
 Eigen::VectorXd SolidParticipant::read(const std::string& field) const {
@@ -175,13 +180,13 @@ Eigen::VectorXd SolidParticipant::read(const std::string& field) const {
   const auto& a = *averages_;
   const auto nc = static_cast<Eigen::Index>(a.fraction.size());
   if (field == "occupancy") return Eigen::Map<const Eigen::VectorXd>(a.fraction.data(), nc);
-  const Eigen::Map<const Eigen::MatrixXd> mean(a.mean.data(), 5, nc);
+  const Eigen::Map<const Eigen::MatrixXd> mean(a.mean.data(), sends_dilatation_ ? 5 : 4, nc);
   if (field == "stress") {
     const Eigen::MatrixXd top = mean.topRows(3);
     return Eigen::Map<const Eigen::VectorXd>(top.data(), 3 * nc);
   }
   if (field == "damage") return mean.row(3).transpose();
-  if (field == "dilatation")
+  if (field == "dilatation" && sends_dilatation_)
     return mean.row(4).transpose().cwiseProduct(Eigen::Map<const Eigen::VectorXd>(a.fraction.data(), nc));
   unknown_field(name(), field);
 }

@@ -90,8 +90,9 @@ class SeepageParticipant final : public Participant {
 class SolidParticipant final : public Participant {
  public:
   // `pressure` is the nodal p [Pa] at the start (the seepage's initial state).
+  // "dilatation" is tracked and sent only with `sends_dilatation` (Biot storage).
   SolidParticipant(mpm::Solver& solver, const MeshMapping& mapping, double biot, Eigen::VectorXd pressure,
-                   std::optional<double> fixed_time_step);
+                   std::optional<double> fixed_time_step, bool sends_dilatation = false);
   std::string name() const override { return "solid"; }
   void write(const std::string& field, const Eigen::VectorXd& values) override;
   Eigen::VectorXd read(const std::string& field) const override;
@@ -119,6 +120,7 @@ class SolidParticipant final : public Participant {
   std::optional<double> fixed_time_step_;
   Eigen::VectorXd pressure_start_, pressure_end_, pressure_now_;
   std::vector<int> cell_hint_;  // per particle, the seepage cell it was last found in
+  bool sends_dilatation_;
   std::vector<double> start_volume_;  // per particle id, at the window's start
   mpm::StepInfo last_window_{0};
   mpm::Solver::State saved_;

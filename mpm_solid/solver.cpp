@@ -562,7 +562,7 @@ double Solver::settle(const Settling& stage, std::optional<double> fixed_step) {
   double largest = 0, kinetic = 0;
   while (time_ < stage.duration * (1 - 1e-12)) {
     step(std::min(fixed_step ? *fixed_step : stable_time_step(), stage.duration - time_));
-    kinetic = energies().kinetic;
+    kinetic = kinetic_energy();
     largest = std::max(largest, kinetic);
   }
   settings_.local_damping = scene_damping;
@@ -586,20 +586,26 @@ void Solver::restore_state(const State& s) {
   if (!same_particles) rebuild_material_groups();
 }
 
+double Solver::kinetic_energy() const {
+  const auto& p = particles_;
+  const int n = static_cast<int>(p.size());
+  double kinetic = 0;
+#pragma omp parallel for schedule(static) reduction(+ : kinetic)
+  for (int i = 0; i < n; ++i) kinetic += 0.5 * p.mass[i] * p.v[i].squaredNorm();
+  return kinetic;
+}
+
 Energies Solver::energies() const {
   Energies e = dissipated_;
   const auto& p = particles_;
   const int n = static_cast<int>(p.size());
   const Vec<2> g = settings_.gravity;
-  double kinetic = 0, gravity = 0;
-#pragma omp parallel for schedule(static) reduction(+ : kinetic, gravity)
-  for (int i = 0; i < n; ++i) {
-    kinetic += 0.5 * p.mass[i] * p.v[i].squaredNorm();
-    gravity -= p.mass[i] * g.dot(p.x[i] - grid_.lower);
-  }
+  double gravity = 0;
+#pragma omp parallel for schedule(static) reduction(+ : gravity)
+  for (int i = 0; i < n; ++i) gravity -= p.mass[i] * g.dot(p.x[i] - grid_.lower);
   e.strain = 0;
   for (std::size_t m = 0; m < materials_.size(); ++m) e.strain += materials_[m]->strain_energy(p, members_[m]);
-  e.kinetic = kinetic;
+  e.kinetic = kinetic_energy();
   e.gravity = gravity;
   return e;
 }

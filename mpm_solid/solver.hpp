@@ -172,6 +172,7 @@ class Solver {
   double settle(const Settling& stage, std::optional<double> fixed_step);
 
   Energies energies() const;
+  double kinetic_energy() const;  // the part of energies() a settling stage watches [J/m]
 
  private:
   template <class Shape, Scheme S, bool Apic>

@@ -71,14 +71,13 @@ Solver::Solver(Mesh mesh, Model model, Settings settings)
       balance_.pressure_boundaries.push_back(model_.boundary_conditions[k].boundary);
   balance_.inflow_through_pressure.assign(balance_.pressure_boundaries.size(), 0.0);
   last_inflow_pressure_.assign(balance_.pressure_boundaries.size(), 0.0);
-  for (Eigen::Index i = 0; i < u_.size(); ++i)
-    balance_.initial_stored += capacity_[i] * storage_x(model_.law, u_[i]);
-  balance_.stored = balance_.initial_stored;
+  restart_balance();
 }
 
 void Solver::setup_system() {
   const std::size_t n = mesh_.num_nodes(), nc = mesh_.num_cells();
   cell_stiffness_.resize(nc);
+  cell_lumped_.resize(nc);
   capacity_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n));
   conductivity_.resize(nc);
   std::vector<Eigen::Triplet<double>> pattern;
@@ -86,6 +85,7 @@ void Solver::setup_system() {
   for (std::size_t c = 0; c < nc; ++c) {
     const auto integrals = q1::integrals(mesh_.corners(c));
     cell_stiffness_[c] = integrals.stiffness;
+    cell_lumped_[c] = integrals.lumped;
     const Material& m = model_.materials[mesh_.cell_region[c]];
     conductivity_[c] = m.conductivity;
     for (int a = 0; a < 4; ++a) {
@@ -217,14 +217,20 @@ void Solver::set_initial_pressure(const std::vector<double>& nodal_p) {
   if (nodal_p.size() != mesh_.num_nodes())
     throw std::invalid_argument(fmt::format("set_initial_pressure: {} values for {} nodes",
                                             nodal_p.size(), mesh_.num_nodes()));
-  balance_.initial_stored = 0;
   for (Eigen::Index i = 0; i < u_.size(); ++i) {
     u_[i] = unknown_from_pressure(model_.law, nodal_p[i]);
     if (model_.law == Law::gas && !(nodal_p[i] > 0))
       throw std::invalid_argument(fmt::format("set_initial_pressure: node {} gets p = {}; the gas law needs p > 0", i, nodal_p[i]));
-    balance_.initial_stored += capacity_[i] * storage_x(model_.law, u_[i]);
   }
   u_previous_ = u_;
+  restart_balance();
+}
+
+// The gas stored now becomes the balance's starting point.
+void Solver::restart_balance() {
+  balance_.initial_stored = 0;
+  for (Eigen::Index i = 0; i < u_.size(); ++i)
+    balance_.initial_stored += capacity_[i] * storage_x(model_.law, u_[i]);
   balance_.stored = balance_.initial_stored;
 }
 
@@ -247,14 +253,9 @@ void Solver::set_cell_source(std::vector<double> per_cell) {
 void Solver::add_storage(double per_pressure) {
   if (steps_ > 0) throw std::logic_error("add_storage: the run has already started");
   if (model_.law != Law::linear) throw std::invalid_argument("add_storage: only for the linear law");
-  for (std::size_t c = 0; c < mesh_.num_cells(); ++c) {
-    const Eigen::Vector4d lumped = q1::integrals(mesh_.corners(c)).lumped;
-    for (int a = 0; a < 4; ++a) capacity_[mesh_.cells[c][a]] += per_pressure * lumped[a];
-  }
-  balance_.initial_stored = 0;
-  for (Eigen::Index i = 0; i < u_.size(); ++i)
-    balance_.initial_stored += capacity_[i] * storage_x(model_.law, u_[i]);
-  balance_.stored = balance_.initial_stored;
+  for (std::size_t c = 0; c < mesh_.num_cells(); ++c)
+    for (int a = 0; a < 4; ++a) capacity_[mesh_.cells[c][a]] += per_pressure * cell_lumped_[c][a];
+  restart_balance();
 }
 
 void Solver::load_vector(double t, Eigen::VectorXd& f) const {
@@ -271,8 +272,7 @@ void Solver::load_vector(double t, Eigen::VectorXd& f) const {
   }
   for (std::size_t c = 0; c < cell_source_.size(); ++c) {
     if (cell_source_[c] == 0) continue;
-    const Eigen::Vector4d lumped = q1::integrals(mesh_.corners(c)).lumped;
-    for (int a = 0; a < 4; ++a) f[mesh_.cells[c][a]] += cell_source_[c] * lumped[a];
+    for (int a = 0; a < 4; ++a) f[mesh_.cells[c][a]] += cell_source_[c] * cell_lumped_[c][a];
   }
   if (!source_) return;
   for (std::size_t c = 0; c < mesh_.num_cells(); ++c) {

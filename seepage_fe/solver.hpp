@@ -137,6 +137,7 @@ class Solver {
 
  private:
   void setup_system();
+  void restart_balance();
   void assemble_conductivity();
   void set_boundary_values(double t, Eigen::VectorXd& u) const;
   void load_vector(double t, Eigen::VectorXd& f) const;
@@ -153,6 +154,7 @@ class Solver {
 
   // Geometry, computed once.
   std::vector<Eigen::Matrix4d> cell_stiffness_;  // unit conductivity
+  std::vector<Eigen::Vector4d> cell_lumped_;     // int N_a dA per cell
   Eigen::VectorXd capacity_;                     // sum over cells of c * int N_a
   std::vector<std::array<int, 16>> scatter_;     // cell entry -> matrix value index
   std::vector<int> diagonal_;                    // node -> value index of (i, i)
