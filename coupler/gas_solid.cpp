@@ -118,10 +118,11 @@ void SeepageParticipant::restore() { solver_.restore_state(saved_); }
 
 SolidParticipant::SolidParticipant(mpm::Solver& solver, const MeshMapping& mapping, double biot,
                                    Eigen::VectorXd pressure, std::optional<double> fixed_time_step,
-                                   bool sends_dilatation)
+                                   bool sends_dilatation, GasForce force)
     : solver_(solver),
       mapping_(mapping),
       biot_(biot),
+      force_(force),
       fixed_time_step_(fixed_time_step),
       pressure_start_(pressure),
       pressure_end_(std::move(pressure)),
@@ -191,15 +192,24 @@ Eigen::VectorXd SolidParticipant::read(const std::string& field) const {
   unknown_field(name(), field);
 }
 
-// The gas force -alpha grad(p) V_p with p interpolated between the window's
-// ends at `fraction` of it.
+// The gas force (-alpha grad(p) V_p, or alpha p in the total stress) with p
+// interpolated between the window's ends at `fraction` of it.
 void SolidParticipant::set_gas_force(double fraction) {
   const auto& p = solver_.particles();
-  auto& force = solver_.external_force();
   pressure_now_ = (1 - fraction) * pressure_start_ + fraction * pressure_end_;
   const int n = static_cast<int>(p.size());
   // Particles leaving the grid renumber the rest: the hints are then only stale.
   cell_hint_.resize(p.size(), -1);
+  if (force_ == GasForce::stress) {
+    auto& pore = solver_.pore_pressure();
+#pragma omp parallel for schedule(static)
+    for (int i = 0; i < n; ++i) {
+      const auto s = mapping_.sample(pressure_now_, p.x[i], &cell_hint_[i]);
+      pore[i] = s ? biot_ * s->value : 0.0;
+    }
+    return;
+  }
+  auto& force = solver_.external_force();
 #pragma omp parallel for schedule(static)
   for (int i = 0; i < n; ++i) {
     const auto s = mapping_.sample(pressure_now_, p.x[i], &cell_hint_[i]);

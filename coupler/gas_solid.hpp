@@ -41,8 +41,20 @@ struct PermeabilityLaw {
   double operator()(double lambda0, double compression, double damage) const;
 };
 
+// How the gas pressure loads the solid. Both are the same force inside a
+// body; they differ by alpha p on its surfaces:
+//   body:   the body force -alpha grad(p) V_p (the paper's, model-notes
+//           section 2): surfaces feel only the pressure drop the seepage
+//           mesh resolves across them; right where surfaces see the open
+//           pressure or rest on rigid rock (the outburst);
+//   stress: alpha p enters each particle's total stress, so the pore
+//           pressure also pushes on surfaces it cannot drain through (a
+//           loading plate: Mandel's problem).
+enum class GasForce { body, stress };
+
 struct GasSolidSettings {
   double biot = 0.5;         // alpha
+  GasForce force = GasForce::body;
   PermeabilityLaw permeability;
   bool permeability_coupling = true;  // off: lambda stays the scene's
   double open_below = 0.5;   // a cell with less solid than this fraction is open space
@@ -92,7 +104,8 @@ class SolidParticipant final : public Participant {
   // `pressure` is the nodal p [Pa] at the start (the seepage's initial state).
   // "dilatation" is tracked and sent only with `sends_dilatation` (Biot storage).
   SolidParticipant(mpm::Solver& solver, const MeshMapping& mapping, double biot, Eigen::VectorXd pressure,
-                   std::optional<double> fixed_time_step, bool sends_dilatation = false);
+                   std::optional<double> fixed_time_step, bool sends_dilatation = false,
+                   GasForce force = GasForce::body);
   std::string name() const override { return "solid"; }
   void write(const std::string& field, const Eigen::VectorXd& values) override;
   Eigen::VectorXd read(const std::string& field) const override;
@@ -117,6 +130,7 @@ class SolidParticipant final : public Participant {
   mpm::Solver& solver_;
   const MeshMapping& mapping_;
   double biot_;
+  GasForce force_;
   std::optional<double> fixed_time_step_;
   Eigen::VectorXd pressure_start_, pressure_end_, pressure_now_;
   std::vector<int> cell_hint_;  // per particle, the seepage cell it was last found in

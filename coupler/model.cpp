@@ -42,7 +42,7 @@ CoupledModel::CoupledModel(CoupledSetup setup) : setup_(std::move(setup)) {
   seepage_side_ = std::make_unique<SeepageParticipant>(*seepage_, gas_solid);
   solid_side_ = std::make_unique<SolidParticipant>(*solid_, *mapping_, cs.gas_solid.biot,
                                                    seepage_side_->read("pressure"), solid.fixed_time_step,
-                                                   cs.gas_solid.biot_storage);
+                                                   cs.gas_solid.biot_storage, cs.gas_solid.force);
   if (cs.total_initial_stress) {
     std::vector<double> cell_pressure;
     for (const int region : mapping_->mesh().cell_region)

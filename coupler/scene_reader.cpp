@@ -96,6 +96,13 @@ CouplingSetup read_coupling(const scene::Table& c) {
   g.biot = c.number({"biot_coefficient", "alpha: total stress = effective - alpha p I (the paper's pore pressure "
                                          "coefficient)",
                      text(gas_default.biot), Range::between(0, 1)});
+  g.force = c.choice({"gas_force", "how the pressure loads the coal: \"body\" (-alpha grad(p) V_p per particle, the "
+                                    "paper's) or \"stress\" (alpha p in each particle's total stress: also pushes on "
+                                    "surfaces the gas cannot drain through, such as a loading plate)",
+                       gas_default.force == GasForce::body ? "body" : "stress"},
+                      {"body", "stress"}) == "stress"
+                ? GasForce::stress
+                : GasForce::body;
   s.total_initial_stress = c.boolean({"total_initial_stress", "the MPM bodies' initial stresses are total: alpha p0 "
                                                               "is added to make them effective",
                                       CouplingSetup{}.total_initial_stress ? "true" : "false"});

@@ -25,6 +25,9 @@ struct Particles {
   std::vector<Mat<Dim>> affine;             // APIC's B matrix
   std::vector<Vec<Dim>> external_force;     // set by another program [N per m]
   std::vector<Vec<Dim>> surface_force;      // boundary tractions of the scene [N per m]
+  // Isotropic pressure another program adds to the total stress (alpha p of a
+  // pore fluid) [Pa]; empty unless it asks for it (Solver::pore_pressure).
+  std::vector<double> pore_pressure;
   std::vector<double> plastic_strain;       // equivalent plastic strain (accumulated)
   std::vector<double> damage;               // D in [0, 1], irreversible (damage materials)
   std::vector<Mat<Dim>> effective_stress;   // undamaged stress sigma~ (damage materials)
@@ -79,6 +82,7 @@ struct Particles {
         affine[to] = affine[from];
         external_force[to] = external_force[from];
         surface_force[to] = surface_force[from];
+        if (!pore_pressure.empty()) pore_pressure[to] = pore_pressure[from];
         plastic_strain[to] = plastic_strain[from];
         damage[to] = damage[from];
         effective_stress[to] = effective_stress[from];
@@ -107,6 +111,7 @@ struct Particles {
     affine.resize(n);
     external_force.resize(n);
     surface_force.resize(n);
+    if (!pore_pressure.empty()) pore_pressure.resize(n);
     plastic_strain.resize(n);
     damage.resize(n);
     effective_stress.resize(n);

@@ -50,6 +50,25 @@ void read_obstacles(const scene::Table& s, Settings& st, const Grid<2>& grid) {
   }
 }
 
+void read_platens(const scene::Table& s, Settings& st, const Grid<2>& grid) {
+  for (const auto& t : s.table_array("platens", "rigid, massless, frictionless loading plates: the grid nodes in "
+                                                "the box move together along the force")) {
+    const auto lo = t.quantity_vector({"box_min", "lower-left corner of the box of grid nodes the plate holds"},
+                                      units::length, 2);
+    const auto hi = t.quantity_vector({"box_max", "upper-right corner of that box"}, units::length, 2);
+    const Vec<2> lov(lo[0], lo[1]), hiv(hi[0], hi[1]);
+    if (!(hiv.array() > lov.array()).all()) t.fail("box_max", "must lie above and right of box_min");
+    if ((hiv.array() < grid.lower.array()).any() || (lov.array() > grid.upper.array()).any())
+      t.fail("box_min", "the platen lies outside the grid");
+    const std::string direction =
+        t.choice({"direction", "the axis the plate moves along: \"x\" or \"y\""}, {"x", "y"});
+    const double force = t.quantity({"force", "load on the plate along that axis per metre of depth (negative: "
+                                              "toward smaller coordinates)"},
+                                    units::force_per_length);
+    st.platens.push_back({lov, hiv, direction == "x" ? 0 : 1, force});
+  }
+}
+
 // Index of the obstacle strictly containing x, if any.
 std::optional<std::size_t> obstacle_at(const std::vector<Obstacle>& obstacles, const Vec<2>& x) {
   for (std::size_t k = 0; k < obstacles.size(); ++k)
@@ -163,6 +182,7 @@ Setup read_setup(const scene::Table& s) {
   }
 
   read_obstacles(s, st, gr);
+  read_platens(s, st, gr);
   if (const auto settle = s.table("settle", "a quasi-static stage before t = 0: in-situ stress and gravity brought "
                                             "to equilibrium with local damping and the supports in place", false)) {
     setup.settling.duration = settle->quantity({"time", "length of the stage", "", Range::positive()}, units::time);

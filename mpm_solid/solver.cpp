@@ -97,6 +97,17 @@ Solver::Solver(Grid<2> grid, std::vector<std::unique_ptr<Material>> materials,
   empty_node_mass_ = settings_.empty_node_mass_fraction * total_mass / static_cast<double>(particles_.size());
   rebuild_material_groups();
   find_obstacle_nodes();
+  for (const Platen& platen : settings_.platens) {
+    if (!(platen.upper.array() > platen.lower.array()).all())
+      throw std::invalid_argument("a platen's upper corner must lie above and right of its lower corner");
+    auto& nodes = platen_nodes_.emplace_back();
+    for (std::size_t i = 0; i < node_ij_.size(); ++i) {
+      const Vec<2> x = grid_.node_position(node_ij_[i]);
+      if ((x.array() >= platen.lower.array()).all() && (x.array() <= platen.upper.array()).all()) nodes.push_back(i);
+    }
+    if (nodes.empty()) throw std::invalid_argument("a platen's box holds no grid node");
+  }
+  platen_displacement_.assign(settings_.platens.size(), 0.0);
   for (const auto& m : materials_) wave_speed_squared_.push_back(std::pow(m->elasticity().p_wave_speed(), 2));
 
   // One kernel per (shape, scheme), chosen here once.
@@ -199,7 +210,28 @@ void Solver::grid_velocities() {
 #pragma omp parallel for schedule(static)
   for (std::size_t i = 0; i < n; ++i)
     velocity_[i] = mass_[i] > empty_node_mass_ ? Vec<2>(momentum_[i] / mass_[i]) : Vec<2>::Zero();
+  apply_platens(velocity_, 0, 0);
   apply_walls(velocity_);
+}
+
+// A massless plate moves with the momentum of the nodes it holds plus its
+// force's impulse, shared over their mass; it moves them all with it.
+void Solver::apply_platens(std::vector<Vec<2>>& velocity, double impulse, double dt) {
+  for (std::size_t k = 0; k < platen_nodes_.size(); ++k) {
+    const Platen& platen = settings_.platens[k];
+    double mass = 0, momentum = 0;
+    for (std::size_t i : platen_nodes_[k])
+      if (mass_[i] > empty_node_mass_) {
+        mass += mass_[i];
+        momentum += mass_[i] * velocity[i][platen.axis];
+      }
+    if (mass == 0) continue;
+    const double v = (momentum + impulse * platen.force) / mass;
+    for (std::size_t i : platen_nodes_[k])
+      if (mass_[i] > empty_node_mass_) velocity[i][platen.axis] = v;
+    platen_displacement_[k] += v * dt;
+    dissipated_.external += platen.force * v * dt;
+  }
 }
 
 template <class Shape>
@@ -273,6 +305,7 @@ void Solver::scatter_forces() {
   const auto& p = particles_;
   const int n = static_cast<int>(p.size());
   const Vec<2> g = settings_.gravity;
+  const double* pore = p.pore_pressure.empty() ? nullptr : p.pore_pressure.data();
   Scatter<Vec<2>> forces{thread_vector_, force_};
   forces.clear();
 #pragma omp parallel num_threads(threads_)
@@ -282,7 +315,8 @@ void Solver::scatter_forces() {
 #pragma omp for schedule(static)
     for (int i = 0; i < n; ++i) {
       s.compute(grid_, p.x[i], p.half_width[i]);
-      const Mat<2> vs = p.volume[i] * p.stress[i];
+      Mat<2> vs = p.volume[i] * p.stress[i];
+      if (pore) vs.diagonal().array() -= p.volume[i] * pore[i];
       const Vec<2> body = p.mass[i] * g + p.external_force[i] + p.surface_force[i];
       for (int k = 0; k < s.count; ++k)
         f[s.node[k]] += s.weight[k] * body - vs.col(0) * s.gradient[0][k] - vs.col(1) * s.gradient[1][k];
@@ -308,17 +342,20 @@ void Solver::grid_update(double dt) {
   }
   // v_new = (v + dt f / m) / (1 + c dt): the viscous force -c m v_new.
   const double c = settings_.viscous_damping, shrink = 1 / (1 + c * dt);
-  double viscous_work = 0;
+#pragma omp parallel for schedule(static)
+  for (std::size_t i = 0; i < n; ++i)
+    velocity_new_[i] =
+        mass_[i] > empty_node_mass_ ? Vec<2>(shrink * (velocity_[i] + dt * force_[i] / mass_[i])) : Vec<2>::Zero();
+  apply_platens(velocity_new_, shrink * dt, dt);  // before the walls: the ghost nodes mirror the plate's motion
+  if (c > 0) {
+    // The damping force -c m v_new works along the way the nodes carry the
+    // particles, v_new dt, as the external forces are booked.
+    double viscous_work = 0;
 #pragma omp parallel for schedule(static) reduction(+ : viscous_work)
-  for (std::size_t i = 0; i < n; ++i) {
-    if (!(mass_[i] > empty_node_mass_)) {
-      velocity_new_[i].setZero();
-      continue;
-    }
-    velocity_new_[i] = shrink * (velocity_[i] + dt * force_[i] / mass_[i]);
-    if (c > 0) viscous_work += c * dt * mass_[i] * velocity_new_[i].dot(0.5 * (velocity_[i] + velocity_new_[i]));
+    for (std::size_t i = 0; i < n; ++i)
+      viscous_work += c * dt * mass_[i] * velocity_new_[i].squaredNorm();
+    dissipated_.damping += viscous_work;
   }
-  dissipated_.damping += viscous_work;
   dissipated_.walls += apply_walls(velocity_new_);
 }
 
@@ -433,8 +470,9 @@ void Solver::gather_motion(double dt) {
         p.v[i] = flip * (p.v[i] + dv) + (1 - flip) * v_pic;
       }
       if constexpr (Move) {
-        p.x[i] += dt * v_pic;
-        count(i, dt, census);
+        const Vec<2> moved = dt * v_pic;
+        p.x[i] += moved;
+        count(i, moved, dt, census);
       }
     }
   }
@@ -473,9 +511,13 @@ void Solver::step_kernel(double dt) {
 
 // Books a moved particle: the work of its external force (with the new
 // velocity), and whether it went wrong or left.
-void Solver::count(int i, double dt, Census& census) const {
+void Solver::count(int i, const Vec<2>& moved, double dt, Census& census) const {
   const auto& p = particles_;
-  census.external_work += (p.external_force[i] + p.surface_force[i]).dot(p.v[i]) * dt;
+  // Along the way the particle went (the grid's velocity), not its own
+  // (FLIP-blended) velocity, which may differ from it.
+  census.external_work += (p.external_force[i] + p.surface_force[i]).dot(moved);
+  // A pore pressure does work on the skeleton as it dilates.
+  if (!p.pore_pressure.empty()) census.external_work += p.pore_pressure[i] * p.volume[i] * p.velocity_gradient[i].trace() * dt;
   if (!p.x[i].allFinite() || !p.v[i].allFinite() || !p.stress[i].allFinite())
     ++census.bad;
   else if (!grid_.inside(p.x[i]))
@@ -491,7 +533,7 @@ Census Solver::move_particles(double dt) {
 #pragma omp parallel for schedule(static) reduction(merge : census)
   for (int i = 0; i < n; ++i) {
     p.x[i] += displacement_[i];
-    count(i, dt, census);
+    count(i, displacement_[i], dt, census);
   }
   return census;
 }
@@ -541,6 +583,11 @@ StepInfo Solver::step(double dt) {
   return info;
 }
 
+std::vector<double>& Solver::pore_pressure() {
+  if (particles_.pore_pressure.empty()) particles_.pore_pressure.assign(particles_.size(), 0.0);
+  return particles_.pore_pressure;
+}
+
 void Solver::shift_initial_stress(const std::vector<double>& per_particle) {
   if (steps_ > 0) throw std::logic_error("shift_initial_stress: the run has already started");
   if (per_particle.size() != particles_.size())
@@ -573,6 +620,7 @@ double Solver::settle(const Settling& stage, std::optional<double> fixed_step) {
   time_ = 0;
   steps_ = 0;
   dissipated_ = {};
+  std::fill(platen_displacement_.begin(), platen_displacement_.end(), 0.0);
   return largest > 0 ? kinetic / largest : 0.0;
 }
 
@@ -581,6 +629,7 @@ void Solver::restore_state(const State& s) {
   time_ = s.time;
   steps_ = s.steps;
   removed_ = s.removed;
+  platen_displacement_ = s.platen_displacement;
   const bool same_particles = s.particles.size() == particles_.size();
   particles_ = s.particles;
   if (!same_particles) rebuild_material_groups();

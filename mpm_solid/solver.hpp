@@ -47,6 +47,16 @@ struct Obstacle {
   bool support = false;
 };
 
+// A rigid, massless, frictionless loading plate: the grid nodes in its box move
+// together along `axis`, pushed by `force` and by what the material beneath
+// pushes back; across that axis they move freely. Unlike a traction, the load
+// shifts toward the stiffer part of the body as it deforms (Mandel's problem).
+struct Platen {
+  Vec<2> lower, upper;
+  int axis = 1;
+  double force = 0;  // along axis, per metre of depth [N/m]
+};
+
 // The quasi-static stage before t = 0: in-situ stress and gravity brought to
 // equilibrium with local damping, supports in place.
 struct Settling {
@@ -77,6 +87,7 @@ struct Settings {
   // left, right, bottom, top of the physical domain
   std::array<Wall, 4> walls;
   std::vector<Obstacle> obstacles;
+  std::vector<Platen> platens;
   // Volumetric-locking remedy: replace each particle's dilatation rate tr(L) by
   // its volume-weighted average mapped to the nodes and back (nodal dilatation
   // smoothing), leaving the deviatoric rate alone. Near-incompressible
@@ -149,6 +160,9 @@ class Solver {
   // Read access, and the per-particle external force another program sets.
   const Particles<2>& particles() const { return particles_; }
   std::vector<Vec<2>>& external_force() { return particles_.external_force; }
+  // The per-particle pore pressure that enters the total stress, created
+  // (zero) on first call; scenes that never call it carry no such field.
+  std::vector<double>& pore_pressure();
   // Adds s_p to each particle's in-plane normal stresses before the first
   // step (alpha p when a coupled scene gives total stresses), and 2 nu s_p to
   // the out-of-plane one: the initial state stays one of plane strain, whose
@@ -161,8 +175,9 @@ class Solver {
     std::size_t removed;
     Particles<2> particles;
     Energies dissipated;
+    std::vector<double> platen_displacement;
   };
-  State save_state() const { return {time_, steps_, removed_, particles_, dissipated_}; }
+  State save_state() const { return {time_, steps_, removed_, particles_, dissipated_, platen_displacement_}; }
   void restore_state(const State& s);
 
   // Runs the quasi-static stage (steps of `fixed_step` or the CFL step), then
@@ -170,6 +185,9 @@ class Solver {
   // energy books at zero, local damping back to the scene's. Returns the
   // kinetic energy left at the end of the stage, relative to its largest.
   double settle(const Settling& stage, std::optional<double> fixed_step);
+
+  // How far each platen has moved along its axis since t = 0 [m].
+  const std::vector<double>& platen_displacement() const { return platen_displacement_; }
 
   Energies energies() const;
   double kinetic_energy() const;  // the part of energies() a settling stage watches [J/m]
@@ -190,10 +208,11 @@ class Solver {
   void grid_velocities();
   void grid_update(double dt);
   double apply_walls(std::vector<Vec<2>>& velocity) const;
+  void apply_platens(std::vector<Vec<2>>& velocity, double impulse, double dt);
   void find_obstacle_nodes();
   void fold_ghosts(std::vector<double>* mass, std::vector<Vec<2>>& vectors) const;
   void update_stresses(double dt);
-  void count(int i, double dt, Census& census) const;
+  void count(int i, const Vec<2>& moved, double dt, Census& census) const;
   Census move_particles(double dt);
   void remove_escaped(const Census& census, StepInfo& info);
   void rebuild_material_groups();
@@ -222,6 +241,8 @@ class Solver {
     std::size_t obstacle;
   };
   std::vector<ObstacleNode> obstacle_nodes_;
+  std::vector<std::vector<std::size_t>> platen_nodes_;  // the nodes each platen holds
+  std::vector<double> platen_displacement_;
   Census census_;  // of the last step's move
 
   double time_ = 0;
