@@ -275,14 +275,15 @@ def write_report(run, args, gradients, path):
         "",
         "## Energy budget (J per m of depth, at the end)",
         "",
-        "| kinetic | strain | plastic | damage | walls (friction) | gas work | balance error |",
+        "| gas work | kinetic | strain | plastic | damage | roof, floor (friction) | balance error |",
         "|---|---|---|---|---|---|---|",
-        f"| {e['kinetic_J_per_m']:.4g} | {e['strain_J_per_m']:.4g} | {e['plastic_J_per_m']:.4g} | "
-        f"{e['damage_J_per_m']:.4g} | {e['walls_J_per_m']:.4g} | {e['external_work_J_per_m']:.4g} | "
-        f"{e['balance_error_J_per_m']:.4g} |",
+        f"| {e['external_work_J_per_m']:.4g} | {e['kinetic_J_per_m']:.4g} | {e['strain_J_per_m']:.4g} | "
+        f"{e['plastic_J_per_m']:.4g} | {e['damage_J_per_m']:.4g} | {e['walls_J_per_m']:.4g} | "
+        f"{e['balance_error_J_per_m']:.4g} ({-e['balance_error_J_per_m'] / e['external_work_J_per_m']:.0%} of "
+        "the gas work lost) |",
         "",
-        "The balance error is what the grid takes from particles colliding and separating "
-        "(see mpm_solid/README.md, Energies).",
+        "The balance error is chiefly what the grid takes from coal colliding and separating within a cell "
+        "(one velocity per node); see mpm_solid/README.md, Energies.",
         "",
         "Figures: fig3_pressure.png, fig4_pressure_profile.png, fig5_damage.png, "
         "fig6_min_principal_stress.png, fig7_velocity.png, fig8_tracer_velocity.png, "
