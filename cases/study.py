@@ -1,0 +1,393 @@
+#!/usr/bin/python3
+"""Accuracy against wall time for one scene: sweep solver knobs, measure each
+run's error, and show which knob buys accuracy cheapest.
+
+usage: study.py STUDY.toml [--out DIR] [--jobs N] [--threads T] [--build build]
+
+STUDY.toml names the scene, the program, a measure module and the knobs:
+
+    scene = "terzaghi.toml"          # beside STUDY.toml
+    program = "outburst"             # seepage-fe, mpm-solid or outburst (or a path from here)
+    measure = "measure.py"           # beside STUDY.toml, see below
+    set = ['scene.end_time="0.3 s"'] # overrides for every run (optional)
+    combine = false                  # true: every combination; false: one knob at a time
+
+    [[knobs]]
+    name = "mpm_cell_size"           # a knob of KNOBS below ...
+    values = ["0.1 m", "0.05 m", "0.025 m"]
+    [[knobs]]
+    key = "mpm.materials[0].youngs_modulus"  # ... or any scene key, named by `label`
+    label = "stiffness"
+    values = ['"10 MPa"', '"20 MPa"']
+
+    [reference]                      # without an analytic solution: a much finer run
+    mpm_cell_size = "0.0125 m"
+
+The measure module defines errors(run_dir) -> {name: error} where an analytic
+solution exists, or else quantities(run_dir) -> {name: value}, compared with
+the reference run's (relative error). A run's error is the largest of its
+named errors. Runs go side by side, `jobs` at a time with `threads` OpenMP
+threads each (jobs x threads never exceeds the cores). Writes DIR/study.csv,
+DIR/study.md and DIR/study.png (error against wall time, Pareto front marked),
+and prints (and writes to DIR/study_orders.csv) each numeric knob's measured order: the slope of log error against
+log value and against log wall time, with R^2 of the fit.
+"""
+import argparse
+import concurrent.futures
+import csv
+import importlib.util
+import itertools
+import math
+import os
+import re
+import subprocess
+import sys
+import time
+import tomllib
+
+import numpy as np
+
+
+class StudyError(Exception):
+    pass
+
+
+# name: (scene key, what it is). Keys with [*] apply to every entry of that array.
+KNOBS = {
+    "mpm_cell_size": ("mpm.grid.cell_size", "MPM grid spacing (a length)"),
+    "particles_per_cell": ("mpm.bodies[*].particles_per_cell", "n for n x n particles per cell"),
+    "shape": ("mpm.shape", '"linear", "gimp" or "bspline"'),
+    "update_scheme": ("mpm.scheme", '"usf", "usl" or "musl"'),
+    "transfer": ("mpm.transfer", '"flip" or "apic"'),
+    "courant": ("mpm.courant", "MPM Courant number"),
+    "seepage_cells": ("seepage.mesh.cells", "structured seepage mesh cells [nx, ny]"),
+    "seepage_time_step": ("seepage.time_step", "seepage (first) time step"),
+    "seepage_time_scheme": ("seepage.time_scheme", '"backward_euler", "crank_nicolson" or "bdf2"'),
+    "newton_tolerance": ("seepage.tolerance", "seepage nonlinear tolerance"),
+    "coupling_scheme": ("coupling", '"explicit", "constant", "aitken" or "iqn_ils"'),
+    "window": ("coupling.window", "coupling window"),
+    "coupling_tolerance": ("coupling.tolerance", "sub-iteration tolerance"),
+}
+
+UNITS = {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "s": 1.0, "ms": 1e-3, "min": 60.0, "h": 3600.0, "d": 86400.0}
+
+
+def numeric(value):
+    """The number a knob value stands for (the product, for cells [nx, ny]); None if categorical."""
+    if isinstance(value, bool):
+        return None
+    if isinstance(value, (int, float)):
+        return float(value)
+    if isinstance(value, list) and value and all(isinstance(v, (int, float)) for v in value):
+        return float(np.prod(value))
+    if isinstance(value, str):
+        m = re.fullmatch(r"\s*([0-9.eE+-]+)\s*([a-z]*)\s*", value)
+        if m and (not m.group(2) or m.group(2) in UNITS):
+            try:
+                return float(m.group(1)) * UNITS.get(m.group(2), 1.0)
+            except ValueError:
+                return None
+    return None
+
+
+def toml_value(value):
+    if isinstance(value, str):
+        return value if value.startswith('"') else '"' + value + '"'
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, list):
+        return "[" + ", ".join(toml_value(v) for v in value) + "]"
+    return repr(value)
+
+
+def count_entries(scene, dotted):
+    node = scene
+    for part in dotted.split("."):
+        node = node.get(part, {}) if isinstance(node, dict) else {}
+    return len(node) if isinstance(node, list) else 0
+
+
+class Knob:
+    def __init__(self, table, where, scene):
+        if "name" in table:
+            name = table["name"]
+            if name not in KNOBS:
+                raise StudyError(f"{where}: unknown knob \"{name}\"; known knobs: {', '.join(KNOBS)} "
+                                 "(or give `key` = a scene key and `label`)")
+            self.label, self.key = name, KNOBS[name][0]
+        elif "key" in table:
+            self.key = table["key"]
+            self.label = table.get("label", self.key)
+        else:
+            raise StudyError(f"{where}: a knob needs `name` (one of {', '.join(KNOBS)}) or `key`")
+        values = table.get("values")
+        if not isinstance(values, list) or not values:
+            raise StudyError(f"{where}: `values` must be a non-empty list")
+        self.values = values
+        self.scene = scene
+
+    def overrides(self, value):
+        if self.label == "coupling_scheme":
+            if value not in ("explicit", "constant", "aitken", "iqn_ils"):
+                raise StudyError(f"coupling_scheme: \"{value}\" is not explicit, constant, aitken or iqn_ils")
+            if value == "explicit":
+                return ['coupling.scheme="explicit"']
+            return ['coupling.scheme="implicit"', f'coupling.acceleration="{value}"']
+        if "[*]" in self.key:
+            array, rest = self.key.split("[*]")
+            n = count_entries(self.scene, array)
+            if n == 0:
+                raise StudyError(f"{self.label}: the scene has no [[{array}]] entries")
+            return [f"{array}[{i}]{rest}={toml_value(value)}" for i in range(n)]
+        return [f"{self.key}={toml_value(value)}"]
+
+
+def load_study(path):
+    try:
+        with open(path, "rb") as f:
+            spec = tomllib.load(f)
+    except (OSError, tomllib.TOMLDecodeError) as e:
+        raise StudyError(f"{path}: {e}")
+    here = os.path.dirname(os.path.abspath(path))
+    for key in ("scene", "program", "measure", "knobs"):
+        if key not in spec:
+            raise StudyError(f"{path}: missing `{key}`")
+    unknown = set(spec) - {"scene", "program", "measure", "knobs", "set", "combine", "reference"}
+    if unknown:
+        raise StudyError(f"{path}: unknown key(s) {', '.join(sorted(unknown))}")
+    scene_path = os.path.join(here, spec["scene"])
+    try:
+        with open(scene_path, "rb") as f:
+            scene = tomllib.load(f)
+    except (OSError, tomllib.TOMLDecodeError) as e:
+        raise StudyError(f"{path}: scene: {e}")
+    knobs = [Knob(t, f"{path}: knobs[{i}]", scene) for i, t in enumerate(spec["knobs"])]
+    spec_ref = spec.get("reference", {})
+    names = {k.label for k in knobs}
+    for name in spec_ref:
+        if name not in names:
+            raise StudyError(f"{path}: reference.{name} is not one of the knobs ({', '.join(sorted(names))})")
+    measure_path = os.path.join(here, spec["measure"])
+    module_spec = importlib.util.spec_from_file_location("measure", measure_path)
+    if module_spec is None or not os.path.exists(measure_path):
+        raise StudyError(f"{path}: measure: no module {measure_path}")
+    measure = importlib.util.module_from_spec(module_spec)
+    module_spec.loader.exec_module(measure)
+    if not hasattr(measure, "errors") and not hasattr(measure, "quantities"):
+        raise StudyError(f"{measure_path}: defines neither errors(run_dir) nor quantities(run_dir)")
+    if not hasattr(measure, "errors") and not spec_ref:
+        raise StudyError(f"{path}: without an analytic errors(run_dir) the study needs a [reference] run")
+    return {"scene": scene_path, "program": spec["program"], "measure": measure, "knobs": knobs,
+            "set": list(spec.get("set", [])), "combine": bool(spec.get("combine", False)), "reference": spec_ref}
+
+
+def program_path(program, build, study_dir):
+    if os.sep in program:
+        return os.path.join(study_dir, program)
+    where = {"seepage-fe": "seepage_fe", "mpm-solid": "mpm_solid", "outburst": "coupler"}
+    if program not in where:
+        raise StudyError(f"program \"{program}\": expected seepage-fe, mpm-solid, outburst or a path")
+    return os.path.join(build, where[program], program)
+
+
+def run_one(program, scene, overrides, directory, threads):
+    command = [program, scene, "-q", "-o", directory]
+    for o in overrides:
+        command += ["--set", o]
+    env = dict(os.environ, OMP_NUM_THREADS=str(threads))
+    start = time.monotonic()
+    done = subprocess.run(command, capture_output=True, text=True, env=env)
+    wall = time.monotonic() - start
+    note = ""
+    if done.returncode != 0:
+        lines = (done.stderr or done.stdout).strip().splitlines()
+        note = lines[-1] if lines else f"exit code {done.returncode}"
+    return wall, note
+
+
+def fit(x, y):
+    """Slope of log y against log x and R^2; None with fewer than 3 usable points."""
+    pts = [(math.log(a), math.log(b)) for a, b in zip(x, y) if a > 0 and b > 0 and math.isfinite(b)]
+    if len(pts) < 3:
+        return None
+    lx, ly = np.array(pts).T
+    slope, intercept = np.polyfit(lx, ly, 1)
+    residual = ly - (slope * lx + intercept)
+    total = ((ly - ly.mean()) ** 2).sum()
+    return float(slope), float(1 - (residual ** 2).sum() / total) if total > 0 else 1.0
+
+
+def pareto(rows):
+    """Indices of runs no other run beats in both wall time and error."""
+    ok = [i for i, r in enumerate(rows) if math.isfinite(r["error"])]
+    front = []
+    for i in ok:
+        if not any(rows[j]["wall_s"] <= rows[i]["wall_s"] and rows[j]["error"] <= rows[i]["error"] and
+                   (rows[j]["wall_s"] < rows[i]["wall_s"] or rows[j]["error"] < rows[i]["error"]) for j in ok):
+            front.append(i)
+    return sorted(front, key=lambda i: rows[i]["wall_s"])
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("study")
+    ap.add_argument("--out", help="output folder (default: results/study_<study folder name>)")
+    ap.add_argument("--jobs", type=int, help="runs side by side (default: cores / threads)")
+    ap.add_argument("--threads", type=int, default=1, help="OpenMP threads per run (default 1)")
+    ap.add_argument("--build", default="build", help="the build folder holding the programs")
+    args = ap.parse_args()
+    try:
+        study = load_study(args.study)
+        program = program_path(study["program"], args.build, os.path.dirname(os.path.abspath(args.study)))
+        if not os.access(program, os.X_OK):
+            raise StudyError(f"program {program} not found: build first, or pass --build")
+    except StudyError as e:
+        sys.exit(f"study: {e}")
+    cores = os.cpu_count() or 1
+    threads = max(1, min(args.threads, cores))
+    jobs = args.jobs or max(1, cores // threads)
+    if jobs * threads > cores:
+        sys.exit(f"study: {jobs} jobs x {threads} threads would oversubscribe {cores} cores")
+    name = os.path.basename(os.path.dirname(os.path.abspath(args.study)))
+    out = args.out or os.path.join("results", f"study_{name}")
+    os.makedirs(out, exist_ok=True)
+    knobs = study["knobs"]
+
+    # The runs: each knob alone around the scene's values, or every combination.
+    runs = []
+    if study["combine"]:
+        for combo in itertools.product(*[k.values for k in knobs]):
+            runs.append(dict(zip([k.label for k in knobs], combo)))
+    else:
+        for k in knobs:
+            for v in k.values:
+                runs.append({k.label: v})
+    try:
+        def overrides(setting):
+            o = list(study["set"])
+            for k in knobs:
+                if k.label in setting:
+                    o += k.overrides(setting[k.label])
+            return o
+        planned = [(f"run_{i:03d}", s, overrides(s)) for i, s in enumerate(runs)]
+        if study["reference"]:
+            planned.insert(0, ("reference", study["reference"], overrides(study["reference"])))
+    except StudyError as e:
+        sys.exit(f"study: {e}")
+
+    print(f"study: {len(planned)} runs of {study['scene']}, {jobs} at a time with {threads} thread(s) each",
+          flush=True)
+    results = {}
+    with concurrent.futures.ThreadPoolExecutor(max_workers=jobs) as pool:
+        futures = {pool.submit(run_one, program, study["scene"], o, os.path.join(out, tag), threads): (tag, s)
+                   for tag, s, o in planned}
+        for f in concurrent.futures.as_completed(futures):
+            tag, setting = futures[f]
+            wall, note = f.result()
+            results[tag] = (wall, note)
+            print(f"  {tag} {setting}: {wall:.1f} s {note}", flush=True)
+
+    measure = study["measure"]
+    reference = None
+    if study["reference"]:
+        wall, note = results["reference"]
+        if note:
+            sys.exit(f"study: the reference run failed: {note}")
+        reference = measure.quantities(os.path.join(out, "reference"))
+    rows = []
+    for tag, setting, _ in planned:
+        if tag == "reference":
+            continue
+        wall, note = results[tag]
+        errors = {}
+        if not note:
+            directory = os.path.join(out, tag)
+            if hasattr(measure, "errors"):
+                errors = measure.errors(directory)
+            else:
+                q = measure.quantities(directory)
+                errors = {k: abs(q[k] - v) / max(abs(v), 1e-300) for k, v in reference.items()}
+        row = {"run": tag, **{k.label: setting.get(k.label, "") for k in knobs}, "wall_s": wall,
+               "error": max(errors.values()) if errors else float("nan"), "note": note}
+        row.update({f"error_{k}": v for k, v in errors.items()})
+        rows.append(row)
+
+    front = set(pareto(rows))
+    for i, r in enumerate(rows):
+        r["pareto"] = i in front
+    fields = []
+    for r in rows:
+        fields += [k for k in r if k not in fields]
+    with open(os.path.join(out, "study.csv"), "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=fields)
+        w.writeheader()
+        w.writerows(rows)
+
+    orders = []
+    for k in knobs:
+        mine = [r for r in rows if r[k.label] != "" and all(r[o.label] == "" for o in knobs if o is not k)] \
+            if not study["combine"] else rows
+        values = [numeric(r[k.label]) for r in mine]
+        if None in values or len(set(values)) < 3:
+            continue
+        by_value = fit(values, [r["error"] for r in mine])
+        by_time = fit([r["wall_s"] for r in mine], [r["error"] for r in mine])
+        if by_value:
+            orders.append((k.label, by_value, by_time))
+
+    lines = [f"# Study: `{os.path.relpath(study['scene'])}`", "",
+             f"Error: {'against the analytic solution' if hasattr(measure, 'errors') else 'relative to the reference run'} "
+             f"({', '.join(sorted({c[6:] for r in rows for c in r if c.startswith('error_')}))}); "
+             f"{jobs} run(s) at a time, {threads} thread(s) each. * marks the Pareto front (no run both faster "
+             "and more accurate).", "",
+             "| " + " | ".join(k.label for k in knobs) + " | wall [s] | error | |",
+             "|" + "---|" * (len(knobs) + 3)]
+    for r in rows:
+        cells = [str(r[k.label]) if r[k.label] != "" else "-" for k in knobs]
+        error = f"{r['error']:.3e}" if math.isfinite(r["error"]) else r["note"][:60]
+        lines.append("| " + " | ".join(cells) + f" | {r['wall_s']:.2f} | {error} | {'*' if r['pareto'] else ''} |")
+    if orders:
+        lines += ["", "| knob | error ~ value^p: p (R^2) | error ~ wall^q: q (R^2) |", "|---|---|---|"]
+        for label, (p, r2), by_time in orders:
+            t = f"{by_time[0]:.2f} ({by_time[1]:.3f})" if by_time else "-"
+            lines.append(f"| {label} | {p:.2f} ({r2:.3f}) | {t} |")
+    with open(os.path.join(out, "study.md"), "w") as f:
+        f.write("\n".join(lines) + "\n")
+    with open(os.path.join(out, "study_orders.csv"), "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["knob", "order_in_value", "r2_value", "order_in_wall_time", "r2_wall_time"])
+        for label, (p, r2), by_time in orders:
+            w.writerow([label, p, r2, by_time[0] if by_time else "", by_time[1] if by_time else ""])
+    print("\n".join(lines))
+
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(6.5, 4.5))
+    for k in knobs:
+        mine = [r for r in rows if r[k.label] != "" and math.isfinite(r["error"])]
+        if not study["combine"]:
+            ax.plot([r["wall_s"] for r in mine], [r["error"] for r in mine], "o-", label=k.label)
+            for r in mine:
+                ax.annotate(str(r[k.label]), (r["wall_s"], r["error"]), fontsize=7, xytext=(3, 3),
+                            textcoords="offset points")
+    if study["combine"]:
+        ok = [r for r in rows if math.isfinite(r["error"])]
+        ax.plot([r["wall_s"] for r in ok], [r["error"] for r in ok], "o", label="runs")
+    f_rows = [rows[i] for i in sorted(front, key=lambda i: rows[i]["wall_s"])]
+    ax.step([r["wall_s"] for r in f_rows], [r["error"] for r in f_rows], "k--", where="post", lw=1,
+            label="Pareto front")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("wall time [s]")
+    ax.set_ylabel("error")
+    ax.set_title(os.path.basename(study["scene"]))
+    ax.legend(fontsize=8)
+    ax.grid(True, which="both", alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "study.png"), dpi=120)
+    print(f"study: {out}/study.csv, study.md, study.png")
+
+
+if __name__ == "__main__":
+    main()
