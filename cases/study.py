@@ -2,7 +2,7 @@
 """Accuracy against wall time for one scene: sweep solver knobs, measure each
 run's error, and show which knob buys accuracy cheapest.
 
-usage: study.py STUDY.toml [--out DIR] [--jobs N] [--threads T] [--build build]
+usage: study.py STUDY.toml [--out DIR] [--jobs N] [--threads T] [--build build] [--check]
 
 STUDY.toml names the scene, the program, a measure module and the knobs:
 
@@ -88,6 +88,18 @@ def numeric(value):
             except ValueError:
                 return None
     return None
+
+
+def short(value):
+    """A knob value as a person would write it (1/3 m, not 0.3333333333333333 m)."""
+    if isinstance(value, str):
+        m = re.fullmatch(r"\s*([0-9.eE+-]+)\s*([a-z]*)\s*", value)
+        if m:
+            try:
+                return f"{float(m.group(1)):.3g} {m.group(2)}".strip()
+            except ValueError:
+                pass
+    return str(value)
 
 
 def toml_value(value):
@@ -235,6 +247,7 @@ def main():
     ap.add_argument("--jobs", type=int, help="runs side by side (default: cores / threads)")
     ap.add_argument("--threads", type=int, default=1, help="OpenMP threads per run (default 1)")
     ap.add_argument("--build", default="build", help="the build folder holding the programs")
+    ap.add_argument("--check", action="store_true", help="validate the study and every run's scene, run nothing")
     args = ap.parse_args()
     try:
         study = load_study(args.study)
@@ -250,7 +263,6 @@ def main():
         sys.exit(f"study: {jobs} jobs x {threads} threads would oversubscribe {cores} cores")
     name = os.path.basename(os.path.dirname(os.path.abspath(args.study)))
     out = args.out or os.path.join("results", f"study_{name}")
-    os.makedirs(out, exist_ok=True)
     knobs = study["knobs"]
 
     # The runs: each knob alone around the scene's values, or every combination.
@@ -275,6 +287,16 @@ def main():
     except StudyError as e:
         sys.exit(f"study: {e}")
 
+    if args.check:
+        for tag, setting, o in planned:
+            command = [program, study["scene"], "--check"] + [x for v in o for x in ("--set", v)]
+            done = subprocess.run(command, capture_output=True, text=True)
+            if done.returncode != 0:
+                lines = (done.stderr or done.stdout).strip().splitlines()
+                sys.exit(f"study: {args.study}: {tag} {setting}: {lines[-1] if lines else 'invalid'}")
+        print(f"study: {args.study}: {len(planned)} runs, every scene valid")
+        return
+    os.makedirs(out, exist_ok=True)
     print(f"study: {len(planned)} runs of {study['scene']}, {jobs} at a time with {threads} thread(s) each",
           flush=True)
     results = {}
@@ -343,7 +365,7 @@ def main():
              "| " + " | ".join(k.label for k in knobs) + " | wall [s] | error | |",
              "|" + "---|" * (len(knobs) + 3)]
     for r in rows:
-        cells = [str(r[k.label]) if r[k.label] != "" else "-" for k in knobs]
+        cells = [short(r[k.label]) if r[k.label] != "" else "-" for k in knobs]
         error = f"{r['error']:.3e}" if math.isfinite(r["error"]) else r["note"][:60]
         lines.append("| " + " | ".join(cells) + f" | {r['wall_s']:.2f} | {error} | {'*' if r['pareto'] else ''} |")
     if orders:
@@ -369,7 +391,7 @@ def main():
         if not study["combine"]:
             ax.plot([r["wall_s"] for r in mine], [r["error"] for r in mine], "o-", label=k.label)
             for r in mine:
-                ax.annotate(str(r[k.label]), (r["wall_s"], r["error"]), fontsize=7, xytext=(3, 3),
+                ax.annotate(short(r[k.label]), (r["wall_s"], r["error"]), fontsize=7, xytext=(3, 3),
                             textcoords="offset points")
     if study["combine"]:
         ok = [r for r in rows if math.isfinite(r["error"])]

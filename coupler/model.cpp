@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <limits>
 
+#include <fmt/format.h>
+
 namespace outburst::coupling {
 
 CoupledSetup read_coupled_setup(scene::Table root) {
@@ -19,6 +21,22 @@ CoupledSetup read_coupled_setup(scene::Table root) {
   if (s.coupling.gas_solid.biot_storage && s.seepage.model.law != seepage::Law::linear)
     coupling->fail("biot_storage", "the Biot storage term is written for the linear Darcy law: set seepage.law = "
                                    "\"linear\" or drop the key");
+  // Every seepage cell the coal fills must hold a particle: an empty one reads
+  // as open space and misses the coal's volume change (measured: Mandel's
+  // pressure grows without bound with particles 0.0625 m apart on 0.05 m cells).
+  double spacing = 0, narrowest = std::numeric_limits<double>::infinity();
+  for (double w : s.solid.particles.half_width) spacing = std::max(spacing, 2 * w * s.solid.grid.h);
+  for (std::size_t c = 0; c < s.seepage.mesh.num_cells(); ++c) {
+    const auto x = s.seepage.mesh.corners(c);
+    for (int k = 0; k < 4; ++k) narrowest = std::min(narrowest, (x[(k + 1) % 4] - x[k]).norm());
+  }
+  if (spacing > narrowest * (1 + 1e-9))
+    root.table("mpm", "", true)->fail(
+        "grid.cell_size", fmt::format("particles {:.4g} m apart cannot fill seepage cells {:.4g} m wide (cells "
+                                      "without a particle read as open space and miss the coal's volume change): "
+                                      "refine the MPM (grid.cell_size, bodies' particles_per_cell) or coarsen the "
+                                      "seepage mesh",
+                                      spacing, narrowest));
   return s;
 }
 

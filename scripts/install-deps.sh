@@ -13,6 +13,8 @@ packages=(
   libhdf5-dev libtomlplusplus-dev libcli11-dev libspdlog-dev libfmt-dev catch2
   # figures, and ParaView's Python for checking that our output opens
   python3 python3-matplotlib python3-numpy python3-h5py python3-paraview
+  # scene files edited by the studies (comments kept)
+  python3-tomlkit
 )
 
 missing=()
