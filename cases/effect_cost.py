@@ -122,6 +122,21 @@ def program_for(doc, build, scene):
     return os.path.join(build, folder, name)
 
 
+def particle_steps(out):
+    """MPM particle-steps of a run (from its mpm_history.csv), or None."""
+    path = os.path.join(out, "mpm_history.csv")
+    if not os.path.exists(path):
+        return None
+    with open(path) as f:
+        rows = list(csv.DictReader(f))
+    total, last_step = 0.0, 0
+    for r in rows:
+        step = int(r["step"])
+        total += (step - last_step) * int(r["particles"])
+        last_step = step
+    return total
+
+
 def timed(program, scene, overrides, out, repeats):
     best, note = float("inf"), ""
     for _ in range(repeats):
@@ -176,7 +191,9 @@ def main():
     rows = []
     for label, path, program in variants:
         wall, note = timed(program, path, args.set, os.path.join(out, label.replace(" ", "_")), args.repeats)
-        rows.append({"variant": label, "program": os.path.basename(program), "wall_s": wall, "note": note})
+        steps = particle_steps(os.path.join(out, label.replace(" ", "_"))) if not note else None
+        rows.append({"variant": label, "program": os.path.basename(program), "wall_s": wall,
+                     "particle_steps_per_s": steps / wall if steps else float("nan"), "note": note})
         print(f"{label}: {wall:.2f} s {note}", flush=True)
 
     full = rows[0]["wall_s"]
@@ -189,11 +206,14 @@ def main():
     lines = [f"# What each effect costs: `{os.path.relpath(scene)}`", "",
              f"Overrides: {', '.join(args.set) if args.set else 'none'}; the shortest of {args.repeats} runs each, "
              "one at a time on every core.", "",
-             "| variant | program | wall [s] | of the all-on time | the effect's share |", "|---|---|---|---|---|"]
+             "A removed effect may also change the motion (and so the number of steps): the MPM throughput "
+             "(particle-steps per second, from mpm_history.csv) separates the cost per step.", "",
+             "| variant | program | wall [s] | of the all-on time | the effect's share | MPM particle-steps/s |",
+             "|---|---|---|---|---|---|"]
     for r in rows:
         share = "" if r is rows[0] else f"{1 - r['ratio_to_all_on']:.0%}"
         lines.append(f"| {r['variant']} | {r['program']} | {r['wall_s']:.2f} | {r['ratio_to_all_on']:.2f} | {share} "
-                     f"{r['note'][:60]} |")
+                     f"{r['note'][:60]} | {r['particle_steps_per_s']:.3g} |")
     if skipped:
         lines += ["", f"Not named by the scene (nothing to remove): {', '.join(skipped)}."]
     with open(os.path.join(out, "effect_cost.md"), "w") as f:
