@@ -45,24 +45,24 @@ def no_seepage(doc):
     return True
 
 
-def no_damage(doc):
+def swap_model(doc, old, new, dropped):
+    """Materials of model `old` become `new`, without the keys only `old` reads."""
     found = False
     for m in materials(doc):
-        if m.get("model") == "elastic_damage":
-            m["model"] = "drucker_prager"
-            drop(m, "tensile_strength", "residual_ratio", "ultimate_strain_ratio", "bulking_factor")
+        if m.get("model") == old:
+            m["model"] = new
+            drop(m, *dropped)
             found = True
     return found
+
+
+def no_damage(doc):
+    return swap_model(doc, "elastic_damage", "drucker_prager",
+                      ("tensile_strength", "residual_ratio", "ultimate_strain_ratio", "bulking_factor"))
 
 
 def no_plasticity(doc):
-    found = False
-    for m in materials(doc):
-        if m.get("model") == "drucker_prager":
-            m["model"] = "elastic"
-            drop(m, "cohesion", "friction_angle", "dilation_angle", "fit")
-            found = True
-    return found
+    return swap_model(doc, "drucker_prager", "elastic", ("cohesion", "friction_angle", "dilation_angle", "fit"))
 
 
 def no_friction(doc):

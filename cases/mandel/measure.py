@@ -2,11 +2,13 @@
 (Abousleiman et al. 1996) at the run's last output: pore pressure (RMS over the
 seepage nodes, over p0) and the settlement of the top particles (relative,
 against the plate's). For cases/study.py."""
-import glob
 import os
+import sys
 
-import h5py
 import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from run_output import particle_state, seepage_state  # noqa: E402
 
 # The scene's values (mandel.toml's header): quarter a x b, force F per metre
 # of depth on the quarter's plate.
@@ -50,20 +52,9 @@ def settlement(t):
     return -B * F / (G * A) * (-(1 - NU) / 2 + (1 - NU_U) * terms.sum())
 
 
-def last(run_dir, prefix):
-    return sorted(glob.glob(os.path.join(run_dir, f"{prefix}_0*.h5")))[-1]
-
-
 def errors(run_dir):
-    with h5py.File(os.path.join(run_dir, "seepage_mesh.h5")) as f:
-        nodes = f["nodes"][:]
-    with h5py.File(last(run_dir, "seepage")) as f:
-        t = float(f.attrs["time"])
-        p = f["mesh/p"][:]
+    t, nodes, p = seepage_state(run_dir)
     rms = float(np.sqrt(np.mean((p - pressure(nodes[:, 0], t)) ** 2)) / P0)
-    with h5py.File(last(run_dir, "particles")) as f:
-        x = f["particles/points"][:, :2]
-        u = f["particles/displacement"][:, :2]
-    x0 = x - u
+    x0, u = particle_state(run_dir)
     top = x0[:, 1] > x0[:, 1].max() - 1e-9
     return {"pressure": rms, "settlement": abs(-u[top, 1].mean() / settlement(t) - 1)}
