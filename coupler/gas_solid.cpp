@@ -168,7 +168,7 @@ void SolidParticipant::compute_averages() const {
     values[k * i] = p.stress[i](0, 0);
     values[k * i + 1] = p.stress[i](1, 1);
     values[k * i + 2] = p.stress[i](0, 1);
-    values[k * i + 3] = p.damage[i];
+    values[k * i + 3] = p.damage.empty() ? 0.0 : p.damage[i];
     // Volume-weighted, this sums to the volume change over the window.
     if (sends_dilatation_)
       values[k * i + 4] = (p.volume[i] - start_volume_[static_cast<std::size_t>(p.id[i])]) / p.volume[i];

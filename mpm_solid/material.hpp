@@ -44,6 +44,10 @@ class Material {
   const std::string& name() const { return name_; }
   const Elasticity& elasticity() const { return elasticity_; }
 
+  // Creates the optional particle fields the model keeps (plastic strain,
+  // damage); the solver calls it before the first step.
+  virtual void create_fields(Particles<2>&) const {}
+
   // Update the stresses of particles `members` over a step dt from their
   // velocity gradients (objective: Jaumann rate, paper eqs. 31-33), and carry
   // their deformation gradients and volumes over the step. Returns the energy
@@ -95,6 +99,9 @@ class DruckerPrager final : public Material {
  public:
   DruckerPrager(std::string name, Elasticity elasticity, double cohesion, double friction_angle,
                 double dilation_angle, DruckerPragerFit::Kind fit);
+  void create_fields(Particles<2>& p) const override {
+    p.need_plastic_strain();
+  }
   Dissipation update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const override;
 
   double alpha() const { return alpha_; }
@@ -143,6 +150,10 @@ struct DamageParameters {
 class ElasticDamage final : public Material {
  public:
   ElasticDamage(std::string name, Elasticity elasticity, DamageParameters damage);
+  void create_fields(Particles<2>& p) const override {
+    p.need_plastic_strain();
+    p.need_damage();
+  }
   Dissipation update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const override;
   // Damage of one particle, given its history value and effective stress.
   double damage(double previous, const Mat<2>& effective, double effective_zz) const;

@@ -45,8 +45,8 @@ void Output::snapshot(const Solver& solver) {
     s_min.push_back(lo);
     material.push_back(p.material[i]);
     id.push_back(p.id[i]);
-    damage.push_back(p.damage[i]);
-    plastic.push_back(p.plastic_strain[i]);
+    damage.push_back(p.damage.empty() ? 0.0 : p.damage[i]);
+    plastic.push_back(p.plastic_strain.empty() ? 0.0 : p.plastic_strain[i]);
   }
   output::Snapshot snap(solver.time());
   snap.set_points("particles", std::move(xyz));
@@ -80,7 +80,9 @@ void Output::history(const Solver& solver, const StepInfo& step) {
     const auto [hi, lo] = principal_extremes(p.stress[i], p.stress_zz[i]);
     tracer_file_ << fmt::format("{:.10g},{},{},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.6g},{:.6g}\n",
                                 solver.time(), found - tracers_.begin(), p.id[i], p.x[i].x(), p.x[i].y(), p.v[i].x(),
-                                p.v[i].y(), p.v[i].norm(), u.x(), u.y(), hi, lo, p.plastic_strain[i], p.damage[i]);
+                                p.v[i].y(), p.v[i].norm(), u.x(), u.y(), hi, lo,
+                                p.plastic_strain.empty() ? 0.0 : p.plastic_strain[i],
+                                p.damage.empty() ? 0.0 : p.damage[i]);
   }
   tracer_file_.flush();
 }

@@ -23,17 +23,35 @@ struct Particles {
   std::vector<Mat<Dim>> velocity_gradient;  // L = grad v of the last step [1/s]
   std::vector<Mat<Dim>> deformation;        // F
   std::vector<Mat<Dim>> affine;             // APIC's B matrix
+  std::vector<std::int32_t> material;       // index into the scene's materials
+  std::vector<std::int32_t> id;             // stable identity (tracers, output)
+
+  // Fields only some scenes need: empty unless created (by need_*, at their
+  // initial values) for a material, a load or another program that uses them;
+  // a scene that names none of those carries none of them.
   std::vector<Vec<Dim>> external_force;     // set by another program [N per m]
   std::vector<Vec<Dim>> surface_force;      // boundary tractions of the scene [N per m]
   // Isotropic pressure another program adds to the total stress (alpha p of a
-  // pore fluid) [Pa]; empty unless it asks for it (Solver::pore_pressure).
+  // pore fluid) [Pa].
   std::vector<double> pore_pressure;
   std::vector<double> plastic_strain;       // equivalent plastic strain (accumulated)
   std::vector<double> damage;               // D in [0, 1], irreversible (damage materials)
   std::vector<Mat<Dim>> effective_stress;   // undamaged stress sigma~ (damage materials)
   std::vector<double> effective_stress_zz;
-  std::vector<std::int32_t> material;       // index into the scene's materials
-  std::vector<std::int32_t> id;             // stable identity (tracers, output)
+
+  void need_loads() {
+    external_force.resize(size(), Vec<Dim>::Zero());
+    surface_force.resize(size(), Vec<Dim>::Zero());
+  }
+  void need_pore_pressure() { pore_pressure.resize(size(), 0.0); }
+  void need_plastic_strain() { plastic_strain.resize(size(), 0.0); }
+  // Damage starts at zero, the undamaged stress at the stress.
+  void need_damage() {
+    if (damage.size() == size()) return;
+    damage.assign(size(), 0.0);
+    effective_stress = stress;
+    effective_stress_zz = stress_zz;
+  }
 
   std::size_t size() const { return x.size(); }
 
@@ -52,14 +70,17 @@ struct Particles {
     velocity_gradient.push_back(Mat<Dim>::Zero());
     deformation.push_back(Mat<Dim>::Identity());
     affine.push_back(Mat<Dim>::Zero());
-    external_force.push_back(Vec<Dim>::Zero());
-    surface_force.push_back(Vec<Dim>::Zero());
-    plastic_strain.push_back(0.0);
-    damage.push_back(0.0);
-    effective_stress.push_back(initial_stress);
-    effective_stress_zz.push_back(initial_stress_zz);
     material.push_back(material_index);
     id.push_back(static_cast<std::int32_t>(id.size()));
+    // Optional fields present already grow with the particles.
+    if (!external_force.empty()) need_loads();
+    if (!pore_pressure.empty()) need_pore_pressure();
+    if (!plastic_strain.empty()) need_plastic_strain();
+    if (!damage.empty()) {
+      damage.push_back(0.0);
+      effective_stress.push_back(initial_stress);
+      effective_stress_zz.push_back(initial_stress_zz);
+    }
   }
 
   // Keep the particles whose flag is set, in order.
@@ -80,13 +101,17 @@ struct Particles {
         velocity_gradient[to] = velocity_gradient[from];
         deformation[to] = deformation[from];
         affine[to] = affine[from];
-        external_force[to] = external_force[from];
-        surface_force[to] = surface_force[from];
+        if (!external_force.empty()) {
+          external_force[to] = external_force[from];
+          surface_force[to] = surface_force[from];
+        }
         if (!pore_pressure.empty()) pore_pressure[to] = pore_pressure[from];
-        plastic_strain[to] = plastic_strain[from];
-        damage[to] = damage[from];
-        effective_stress[to] = effective_stress[from];
-        effective_stress_zz[to] = effective_stress_zz[from];
+        if (!plastic_strain.empty()) plastic_strain[to] = plastic_strain[from];
+        if (!damage.empty()) {
+          damage[to] = damage[from];
+          effective_stress[to] = effective_stress[from];
+          effective_stress_zz[to] = effective_stress_zz[from];
+        }
         material[to] = material[from];
         id[to] = id[from];
       }
@@ -109,13 +134,17 @@ struct Particles {
     velocity_gradient.resize(n);
     deformation.resize(n);
     affine.resize(n);
-    external_force.resize(n);
-    surface_force.resize(n);
+    if (!external_force.empty()) {
+      external_force.resize(n);
+      surface_force.resize(n);
+    }
     if (!pore_pressure.empty()) pore_pressure.resize(n);
-    plastic_strain.resize(n);
-    damage.resize(n);
-    effective_stress.resize(n);
-    effective_stress_zz.resize(n);
+    if (!plastic_strain.empty()) plastic_strain.resize(n);
+    if (!damage.empty()) {
+      damage.resize(n);
+      effective_stress.resize(n);
+      effective_stress_zz.resize(n);
+    }
     material.resize(n);
     id.resize(n);
   }

@@ -113,6 +113,7 @@ void read_tractions(const scene::Table& s, Setup& setup) {
         extreme = std::max(extreme, sign * p.x[i][axis]);
       }
     if (inside.empty()) t.fail("box_min", "the box holds no particle to load");
+    p.need_loads();
     for (std::size_t i : inside) {
       const double spacing = 2 * p.half_width[i] * setup.grid.h;
       if (sign * p.x[i][axis] >= extreme - 0.5 * spacing) p.surface_force[i] += Vec<2>(value[0], value[1]) * spacing;

@@ -95,6 +95,7 @@ Solver::Solver(Grid<2> grid, std::vector<std::unique_ptr<Material>> materials,
   double total_mass = 0;
   for (double m : particles_.mass) total_mass += m;
   empty_node_mass_ = settings_.empty_node_mass_fraction * total_mass / static_cast<double>(particles_.size());
+  for (const auto& m : materials_) m->create_fields(particles_);
   rebuild_material_groups();
   find_obstacle_nodes();
   for (const Platen& platen : settings_.platens) {
@@ -306,6 +307,9 @@ void Solver::scatter_forces() {
   const int n = static_cast<int>(p.size());
   const Vec<2> g = settings_.gravity;
   const double* pore = p.pore_pressure.empty() ? nullptr : p.pore_pressure.data();
+  const bool loads = !p.external_force.empty();
+  // A scene without gravity or loads skips the body-force term altogether.
+  const bool body_forces = loads || g.squaredNorm() > 0;
   Scatter<Vec<2>> forces{thread_vector_, force_};
   forces.clear();
 #pragma omp parallel num_threads(threads_)
@@ -317,7 +321,12 @@ void Solver::scatter_forces() {
       s.compute(grid_, p.x[i], p.half_width[i]);
       Mat<2> vs = p.volume[i] * p.stress[i];
       if (pore) vs.diagonal().array() -= p.volume[i] * pore[i];
-      const Vec<2> body = p.mass[i] * g + p.external_force[i] + p.surface_force[i];
+      if (!body_forces) {
+        for (int k = 0; k < s.count; ++k) f[s.node[k]] -= vs.col(0) * s.gradient[0][k] + vs.col(1) * s.gradient[1][k];
+        continue;
+      }
+      const Vec<2> body = loads ? Vec<2>(p.mass[i] * g + p.external_force[i] + p.surface_force[i])
+                                : Vec<2>(p.mass[i] * g);
       for (int k = 0; k < s.count; ++k)
         f[s.node[k]] += s.weight[k] * body - vs.col(0) * s.gradient[0][k] - vs.col(1) * s.gradient[1][k];
     }
@@ -515,7 +524,7 @@ void Solver::count(int i, const Vec<2>& moved, double dt, Census& census) const 
   const auto& p = particles_;
   // Along the way the particle went (the grid's velocity), not its own
   // (FLIP-blended) velocity, which may differ from it.
-  census.external_work += (p.external_force[i] + p.surface_force[i]).dot(moved);
+  if (!p.external_force.empty()) census.external_work += (p.external_force[i] + p.surface_force[i]).dot(moved);
   // A pore pressure does work on the skeleton as it dilates.
   if (!p.pore_pressure.empty()) census.external_work += p.pore_pressure[i] * p.volume[i] * p.velocity_gradient[i].trace() * dt;
   if (!p.x[i].allFinite() || !p.v[i].allFinite() || !p.stress[i].allFinite())
@@ -584,7 +593,7 @@ StepInfo Solver::step(double dt) {
 }
 
 std::vector<double>& Solver::pore_pressure() {
-  if (particles_.pore_pressure.empty()) particles_.pore_pressure.assign(particles_.size(), 0.0);
+  particles_.need_pore_pressure();
   return particles_.pore_pressure;
 }
 
@@ -598,8 +607,10 @@ void Solver::shift_initial_stress(const std::vector<double>& per_particle) {
     const double out_of_plane = 2 * materials_[p.material[i]]->elasticity().poisson_ratio * per_particle[i];
     p.stress[i].diagonal().array() += per_particle[i];
     p.stress_zz[i] += out_of_plane;
-    p.effective_stress[i].diagonal().array() += per_particle[i];
-    p.effective_stress_zz[i] += out_of_plane;
+    if (!p.damage.empty()) {
+      p.effective_stress[i].diagonal().array() += per_particle[i];
+      p.effective_stress_zz[i] += out_of_plane;
+    }
   }
 }
 

@@ -17,6 +17,8 @@ const Elasticity coal{1600, 6e9, 0.4};
 Particles<2> one_particle() {
   Particles<2> p;
   p.add(Vec<2>::Zero(), Vec<2>::Zero(), 1, 1, 0.25, Mat<2>::Zero(), 0, 0);
+  p.need_plastic_strain();  // what the damage and plasticity models keep
+  p.need_damage();
   return p;
 }
 
