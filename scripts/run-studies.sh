@@ -5,7 +5,7 @@
 # About 15 minutes on 2 cores. Needs a build (scripts/run-main.sh makes one).
 set -eu
 cd "$(dirname "$0")/.."
-for case in terzaghi mandel outburst; do
+for case in bar drainage terzaghi mandel outburst; do
   out=results/study_$case
   /usr/bin/python3 cases/study.py cases/$case/study.toml --out "$out"
   mkdir -p cases/$case/study
