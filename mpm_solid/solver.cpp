@@ -50,6 +50,19 @@ struct Scatter {
   }
 };
 
+// scripts/unnamed-effects-benchmark.sh compares the full build with one
+// compiled without gravity, loads and pore pressure (OUTBURST_MPM_LEAN).
+#ifdef OUTBURST_MPM_LEAN
+constexpr bool lean_build = true;
+#else
+constexpr bool lean_build = false;
+#endif
+
+void refuse_in_lean_build(bool named, const char* what) {
+  if (lean_build && named)
+    throw std::invalid_argument(fmt::format("this build (OUTBURST_MPM_LEAN) has no {}", what));
+}
+
 // A wall condition at one node; n is the unit normal pointing into the wall.
 // Friction walls act only on nodes moving into them: the normal velocity is
 // removed and the tangential one reduced by mu times that change. Returns the
@@ -95,6 +108,8 @@ Solver::Solver(Grid<2> grid, std::vector<std::unique_ptr<Material>> materials,
   double total_mass = 0;
   for (double m : particles_.mass) total_mass += m;
   empty_node_mass_ = settings_.empty_node_mass_fraction * total_mass / static_cast<double>(particles_.size());
+  refuse_in_lean_build(settings_.gravity.squaredNorm() > 0, "gravity");
+  refuse_in_lean_build(!particles_.surface_force.empty(), "tractions");
   for (const auto& m : materials_) m->create_fields(particles_);
   rebuild_material_groups();
   find_obstacle_nodes();
@@ -306,10 +321,10 @@ void Solver::scatter_forces() {
   const auto& p = particles_;
   const int n = static_cast<int>(p.size());
   const Vec<2> g = settings_.gravity;
-  const double* pore = p.pore_pressure.empty() ? nullptr : p.pore_pressure.data();
-  const bool loads = !p.external_force.empty();
+  const double* pore = lean_build || p.pore_pressure.empty() ? nullptr : p.pore_pressure.data();
+  const bool loads = !lean_build && !p.external_force.empty();
   // A scene without gravity or loads skips the body-force term altogether.
-  const bool body_forces = loads || g.squaredNorm() > 0;
+  const bool body_forces = !lean_build && (loads || g.squaredNorm() > 0);
   Scatter<Vec<2>> forces{thread_vector_, force_};
   forces.clear();
 #pragma omp parallel num_threads(threads_)
@@ -524,9 +539,11 @@ void Solver::count(int i, const Vec<2>& moved, double dt, Census& census) const 
   const auto& p = particles_;
   // Along the way the particle went (the grid's velocity), not its own
   // (FLIP-blended) velocity, which may differ from it.
-  if (!p.external_force.empty()) census.external_work += (p.external_force[i] + p.surface_force[i]).dot(moved);
+  if (!lean_build && !p.external_force.empty())
+    census.external_work += (p.external_force[i] + p.surface_force[i]).dot(moved);
   // A pore pressure does work on the skeleton as it dilates.
-  if (!p.pore_pressure.empty()) census.external_work += p.pore_pressure[i] * p.volume[i] * p.velocity_gradient[i].trace() * dt;
+  if (!lean_build && !p.pore_pressure.empty())
+    census.external_work += p.pore_pressure[i] * p.volume[i] * p.velocity_gradient[i].trace() * dt;
   if (!p.x[i].allFinite() || !p.v[i].allFinite() || !p.stress[i].allFinite())
     ++census.bad;
   else if (!grid_.inside(p.x[i]))
@@ -592,7 +609,14 @@ StepInfo Solver::step(double dt) {
   return info;
 }
 
+std::vector<Vec<2>>& Solver::external_force() {
+  refuse_in_lean_build(true, "external forces");
+  particles_.need_loads();
+  return particles_.external_force;
+}
+
 std::vector<double>& Solver::pore_pressure() {
+  refuse_in_lean_build(true, "pore pressure");
   particles_.need_pore_pressure();
   return particles_.pore_pressure;
 }

@@ -160,10 +160,7 @@ class Solver {
   // Read access, and the per-particle external force another program sets.
   const Particles<2>& particles() const { return particles_; }
   // Created (zero) on first call, with the scene's tractions.
-  std::vector<Vec<2>>& external_force() {
-    particles_.need_loads();
-    return particles_.external_force;
-  }
+  std::vector<Vec<2>>& external_force();
   // The per-particle pore pressure that enters the total stress, created
   // (zero) on first call; scenes that never call it carry no such field.
   std::vector<double>& pore_pressure();

@@ -6,12 +6,18 @@
 // released under gravity onto a fixed floor, so that every step does real
 // work (moving particles, changing stresses).
 // Usage: mpm-benchmark [particles ...]   (default 1e4 1e5 1e6)
+//        mpm-benchmark --unloaded [particles]   (default 1e5)
+// --unloaded: one line, the throughput of an elastic block spinning free of
+// gravity and loads (B-splines, 1 thread, best of 5): what
+// scripts/unnamed-effects-benchmark.sh compares between the full build and
+// one without gravity, loads and pore pressure (OUTBURST_MPM_LEAN).
 #include <omp.h>
 
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <string>
 
 #include "mpm_solid/scene_reader.hpp"
 #include "mpm_solid/solver.hpp"
@@ -24,6 +30,42 @@ namespace {
 enum class Model { elastic, drucker_prager, elastic_damage };
 const char* model_name(Model m) {
   return m == Model::elastic ? "elastic" : m == Model::drucker_prager ? "drucker_prager" : "elastic_damage";
+}
+
+double unloaded_particle_steps_per_second(long particles) {
+  omp_set_num_threads(1);
+  const int per_cell = 2;
+  const int side = static_cast<int>(std::lround(std::sqrt(static_cast<double>(particles)) / per_cell));
+  Grid<2> g;
+  g.h = 1.0;
+  g.lower = {0, 0};
+  g.cells = {side * 2, side * 2};
+  g.upper = {g.cells[0] * g.h, g.cells[1] * g.h};
+  std::vector<Vec<2>> points;
+  const Vec<2> centre(side, side);
+  fill_cells(g, per_cell, centre.array() - side / 2.0, centre.array() + side / 2.0,
+             [](const Vec<2>&) { return true; }, points);
+  Particles<2> p;
+  const double volume = 1.0 / (per_cell * per_cell);
+  for (const auto& x : points) {
+    const Vec<2> r = x - centre;
+    p.add(x, 0.01 * Vec<2>(-r.y(), r.x()), 1600 * volume, volume, 0.5 / per_cell, Mat<2>::Zero(), 0, 0);
+  }
+  std::vector<std::unique_ptr<Material>> materials;
+  materials.push_back(std::make_unique<LinearElastic>("coal", Elasticity{1600, 6e7, 0.3}));
+  Solver solver(g, std::move(materials), std::move(p), Settings{});
+  const double dt = solver.stable_time_step();
+  const long n = static_cast<long>(solver.particles().size());
+  for (int i = 0; i < 3; ++i) solver.step(dt);
+  const int steps = static_cast<int>(std::max(5L, 10000000L / n));
+  double best = 0;
+  for (int repeat = 0; repeat < 5; ++repeat) {
+    const auto start = std::chrono::steady_clock::now();
+    for (int i = 0; i < steps; ++i) solver.step(dt);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    best = std::max(best, static_cast<double>(n) * steps / seconds);
+  }
+  return best;
 }
 
 double particle_steps_per_second(long particles, ShapeKind shape, Model model, int threads) {
@@ -73,6 +115,15 @@ double particle_steps_per_second(long particles, ShapeKind shape, Model model, i
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (argc >= 2 && std::string(argv[1]) == "--unloaded") {
+    const double n = argc >= 3 ? std::strtod(argv[2], nullptr) : 1e5;
+    if (!(n >= 100)) {
+      std::fprintf(stderr, "usage: mpm-benchmark --unloaded [particles]   (at least 100)\n");
+      return 2;
+    }
+    std::printf("%.6e\n", unloaded_particle_steps_per_second(std::lround(n)));
+    return 0;
+  }
   std::vector<long> sizes;
   for (int i = 1; i < argc; ++i) {
     char* end = nullptr;
