@@ -7,8 +7,9 @@ usage: study.py STUDY.toml [--out DIR] [--jobs N] [--threads T] [--build build] 
 STUDY.toml names the scene, the program, a measure module and the knobs:
 
     scene = "terzaghi.toml"          # beside STUDY.toml
-    program = "outburst"             # seepage-fe, mpm-solid or outburst (or a path from here)
-    measure = "measure.py"           # beside STUDY.toml, see below
+    program = "outburst"             # seepage-fe, mpm-solid, outburst or a path from here
+                                     # (optional: the one the scene's solvers call for)
+    measure = "measure.py"           # beside STUDY.toml, see below (optional)
     set = ['scene.end_time="0.3 s"'] # overrides for every run (optional)
     combine = false                  # true: every combination; false: one knob at a time
 
@@ -25,7 +26,9 @@ STUDY.toml names the scene, the program, a measure module and the knobs:
 
 The measure module defines errors(run_dir) -> {name: error} where an analytic
 solution exists, or else quantities(run_dir) -> {name: value}, compared with
-the reference run's (relative error). A run's error is the largest of its
+the reference run's (relative error). Without one, cases/generic_measure.py
+compares mean and largest pressure and displacement with the reference's: any
+scene can be studied given a [reference]. A run's error is the largest of its
 named errors. Runs go side by side, `jobs` at a time with `threads` OpenMP
 threads each (jobs x threads never exceeds the cores). Writes DIR/study.csv,
 DIR/study.md and DIR/study.png (error against wall time, Pareto front marked),
@@ -161,7 +164,7 @@ def load_study(path):
     except (OSError, tomllib.TOMLDecodeError) as e:
         raise StudyError(f"{path}: {e}")
     here = os.path.dirname(os.path.abspath(path))
-    for key in ("scene", "program", "measure", "knobs"):
+    for key in ("scene", "knobs"):
         if key not in spec:
             raise StudyError(f"{path}: missing `{key}`")
     unknown = set(spec) - {"scene", "program", "measure", "knobs", "set", "combine", "reference"}
@@ -179,7 +182,9 @@ def load_study(path):
     for name in spec_ref:
         if name not in names:
             raise StudyError(f"{path}: reference.{name} is not one of the knobs ({', '.join(sorted(names))})")
-    measure_path = os.path.join(here, spec["measure"])
+    measure_path = os.path.join(here, spec["measure"]) if "measure" in spec else \
+        os.path.join(os.path.dirname(os.path.abspath(__file__)), "generic_measure.py")
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))  # run_output for the measures
     module_spec = importlib.util.spec_from_file_location("measure", measure_path)
     if module_spec is None or not os.path.exists(measure_path):
         raise StudyError(f"{path}: measure: no module {measure_path}")
@@ -189,7 +194,11 @@ def load_study(path):
         raise StudyError(f"{measure_path}: defines neither errors(run_dir) nor quantities(run_dir)")
     if not hasattr(measure, "errors") and not spec_ref:
         raise StudyError(f"{path}: without an analytic errors(run_dir) the study needs a [reference] run")
-    return {"scene": scene_path, "program": spec["program"], "measure": measure, "knobs": knobs,
+    solvers = tuple(sorted(scene.get("scene", {}).get("solvers", [])))
+    default_program = {("mpm",): "mpm-solid", ("seepage",): "seepage-fe", ("mpm", "seepage"): "outburst"}
+    if "program" not in spec and solvers not in default_program:
+        raise StudyError(f"{path}: name the `program` (the scene's solvers {list(solvers)} call for none)")
+    return {"scene": scene_path, "program": spec.get("program", default_program.get(solvers)), "measure": measure, "knobs": knobs,
             "set": list(spec.get("set", [])), "combine": bool(spec.get("combine", False)), "reference": spec_ref}
 
 
