@@ -116,17 +116,16 @@ void SeepageParticipant::restore() { solver_.restore_state(saved_); }
 
 // ---- solid
 
-SolidParticipant::SolidParticipant(mpm::Solver& solver, const MeshMapping& mapping, double biot,
-                                   Eigen::VectorXd pressure, std::optional<double> fixed_time_step,
-                                   bool sends_dilatation, GasForce force)
+SolidParticipant::SolidParticipant(mpm::Solver& solver, const MeshMapping& mapping, const GasSolidSettings& settings,
+                                   Eigen::VectorXd pressure, std::optional<double> fixed_time_step)
     : solver_(solver),
       mapping_(mapping),
-      biot_(biot),
-      force_(force),
+      biot_(settings.biot),
+      force_(settings.force),
       fixed_time_step_(fixed_time_step),
       pressure_start_(pressure),
       pressure_end_(std::move(pressure)),
-      sends_dilatation_(sends_dilatation) {
+      sends_dilatation_(settings.biot_storage) {
   if (pressure_start_.size() != static_cast<Eigen::Index>(mapping_.mesh().num_nodes()))
     throw std::invalid_argument("solid: the initial pressure does not match the seepage mesh");
   mark_window_start();

@@ -102,10 +102,10 @@ class SeepageParticipant final : public Participant {
 class SolidParticipant final : public Participant {
  public:
   // `pressure` is the nodal p [Pa] at the start (the seepage's initial state).
-  // "dilatation" is tracked and sent only with `sends_dilatation` (Biot storage).
-  SolidParticipant(mpm::Solver& solver, const MeshMapping& mapping, double biot, Eigen::VectorXd pressure,
-                   std::optional<double> fixed_time_step, bool sends_dilatation = false,
-                   GasForce force = GasForce::body);
+  // Of `settings` it uses alpha, the gas force's form, and Biot storage
+  // ("dilatation" is tracked and sent only with it).
+  SolidParticipant(mpm::Solver& solver, const MeshMapping& mapping, const GasSolidSettings& settings,
+                   Eigen::VectorXd pressure, std::optional<double> fixed_time_step);
   std::string name() const override { return "solid"; }
   void write(const std::string& field, const Eigen::VectorXd& values) override;
   Eigen::VectorXd read(const std::string& field) const override;

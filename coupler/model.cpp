@@ -58,9 +58,8 @@ CoupledModel::CoupledModel(CoupledSetup setup) : setup_(std::move(setup)) {
     gas_solid.fixed_stress = gas_solid.biot * gas_solid.biot / bulk;
   }
   seepage_side_ = std::make_unique<SeepageParticipant>(*seepage_, gas_solid);
-  solid_side_ = std::make_unique<SolidParticipant>(*solid_, *mapping_, cs.gas_solid.biot,
-                                                   seepage_side_->read("pressure"), solid.fixed_time_step,
-                                                   cs.gas_solid.biot_storage, cs.gas_solid.force);
+  solid_side_ = std::make_unique<SolidParticipant>(*solid_, *mapping_, gas_solid, seepage_side_->read("pressure"),
+                                                   solid.fixed_time_step);
   if (cs.total_initial_stress) {
     std::vector<double> cell_pressure;
     for (const int region : mapping_->mesh().cell_region)

@@ -104,7 +104,7 @@ TEST_CASE("one-way: a column under a linear gas pressure settles to the analytic
   gs.permeability_coupling = false;
   SeepageParticipant seepage_side(seep, gs);
   const MeshMapping map(seep.mesh());
-  SolidParticipant solid_side(solid, map, alpha, seepage_side.read("pressure"), std::nullopt);
+  SolidParticipant solid_side(solid, map, gs, seepage_side.read("pressure"), std::nullopt);
   SchemeSettings scheme;
   scheme.kind = SchemeSettings::Kind::one_way;
   scheme.to_second = {"pressure"};
