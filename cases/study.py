@@ -26,7 +26,9 @@ STUDY.toml names the scene, the program, a measure module and the knobs:
 
 The measure module defines errors(run_dir) -> {name: error} where an analytic
 solution exists, or else quantities(run_dir) -> {name: value}, compared with
-the reference run's (relative error). Without one, cases/generic_measure.py
+the reference run's (relative error; a value may be an array, a field on a
+mesh all runs share, compared by its RMS difference over the reference's
+largest magnitude). Without one, cases/generic_measure.py
 compares mean and largest pressure and displacement with the reference's: any
 scene can be studied given a [reference]. A run's error is the largest of its
 named errors. Runs go side by side, `jobs` at a time with `threads` OpenMP
@@ -67,7 +69,7 @@ KNOBS = {
     "seepage_time_step": ("seepage.time_step", "seepage (first) time step"),
     "seepage_time_scheme": ("seepage.time_scheme", '"backward_euler", "crank_nicolson" or "bdf2"'),
     "newton_tolerance": ("seepage.tolerance", "seepage nonlinear tolerance"),
-    "coupling_scheme": ("coupling", '"explicit", "constant", "aitken" or "iqn_ils"'),
+    "coupling_scheme": ("coupling", '"explicit", "explicit_fixed_stress", "constant", "aitken" or "iqn_ils"'),
     "window": ("coupling.window", "coupling window"),
     "coupling_tolerance": ("coupling.tolerance", "sub-iteration tolerance"),
 }
@@ -143,10 +145,11 @@ class Knob:
 
     def overrides(self, value):
         if self.label == "coupling_scheme":
-            if value not in ("explicit", "constant", "aitken", "iqn_ils"):
-                raise StudyError(f"coupling_scheme: \"{value}\" is not explicit, constant, aitken or iqn_ils")
-            if value == "explicit":
-                return ['coupling.scheme="explicit"']
+            if value not in ("explicit", "explicit_fixed_stress", "constant", "aitken", "iqn_ils"):
+                raise StudyError(f"coupling_scheme: \"{value}\" is not explicit, explicit_fixed_stress, constant, "
+                                 "aitken or iqn_ils")
+            if value.startswith("explicit"):
+                return ['coupling.scheme="explicit"'] + (["coupling.fixed_stress=true"] if "fixed" in value else [])
             return ['coupling.scheme="implicit"', f'coupling.acceleration="{value}"']
         if "[*]" in self.key:
             array, rest = self.key.split("[*]")
@@ -236,6 +239,26 @@ def fit(x, y):
     residual = ly - (slope * lx + intercept)
     total = ((ly - ly.mean()) ** 2).sum()
     return float(slope), float(1 - (residual ** 2).sum() / total) if total > 0 else 1.0
+
+
+def difference(value, reference):
+    """Relative error of a quantity: of a number, or RMS of a field over the reference's largest magnitude."""
+    value, reference = np.asarray(value, dtype=float), np.asarray(reference, dtype=float)
+    if value.shape != reference.shape:
+        raise StudyError(f"a field of {value.size} values against the reference's {reference.size}: fields compare "
+                         "only on a mesh every run shares")
+    scale = max(float(np.abs(reference).max()), 1e-300)
+    return float(np.sqrt(np.mean((value - reference) ** 2)) / scale) if value.ndim else abs(float(value - reference)) / scale
+
+
+def sub_iterations(run_dir):
+    """Mean coupling sub-iterations per window of a coupled run, or None."""
+    path = os.path.join(run_dir, "coupling.csv")
+    if not os.path.exists(path):
+        return None
+    with open(path) as f:
+        counts = [int(r["iterations"]) for r in csv.DictReader(f)]
+    return sum(counts) / len(counts) if counts else None
 
 
 def pareto(rows):
@@ -330,16 +353,22 @@ def main():
         if tag == "reference":
             continue
         wall, note = results[tag]
-        errors = {}
+        errors, iterations = {}, None
         if not note:
             directory = os.path.join(out, tag)
-            if hasattr(measure, "errors"):
-                errors = measure.errors(directory)
-            else:
-                q = measure.quantities(directory)
-                errors = {k: abs(q[k] - v) / max(abs(v), 1e-300) for k, v in reference.items()}
+            iterations = sub_iterations(directory)
+            try:
+                if hasattr(measure, "errors"):
+                    errors = measure.errors(directory)
+                else:
+                    q = measure.quantities(directory)
+                    errors = {k: difference(q[k], v) for k, v in reference.items()}
+            except StudyError as e:
+                sys.exit(f"study: {tag}: {e}")
         row = {"run": tag, **{k.label: setting.get(k.label, "") for k in knobs}, "wall_s": wall,
                "error": max(errors.values()) if errors else float("nan"), "note": note}
+        if iterations is not None:
+            row["sub_iterations"] = iterations
         row.update({f"error_{k}": v for k, v in errors.items()})
         rows.append(row)
 
@@ -354,27 +383,39 @@ def main():
         w.writeheader()
         w.writerows(rows)
 
+    # Each numeric knob's order: alone, or (combined) for each setting of the others.
     orders = []
     for k in knobs:
-        mine = [r for r in rows if r[k.label] != "" and all(r[o.label] == "" for o in knobs if o is not k)] \
-            if not study["combine"] else rows
-        values = [numeric(r[k.label]) for r in mine]
-        if None in values or len(set(values)) < 3:
-            continue
-        by_value = fit(values, [r["error"] for r in mine])
-        by_time = fit([r["wall_s"] for r in mine], [r["error"] for r in mine])
-        if by_value:
-            orders.append((k.label, by_value, by_time))
+        others = [o for o in knobs if o is not k]
+        if study["combine"]:
+            groups = {}
+            for r in rows:
+                groups.setdefault(tuple(short(r[o.label]) for o in others), []).append(r)
+        else:
+            groups = {(): [r for r in rows if r[k.label] != "" and all(r[o.label] == "" for o in others)]}
+        for key, mine in groups.items():
+            values = [numeric(r[k.label]) for r in mine]
+            if None in values or len(set(values)) < 3:
+                continue
+            by_value = fit(values, [r["error"] for r in mine])
+            by_time = fit([r["wall_s"] for r in mine], [r["error"] for r in mine])
+            label = k.label + (" (" + ", ".join(f"{o.label} {v}" for o, v in zip(others, key)) + ")" if key else "")
+            if by_value:
+                orders.append((label, by_value, by_time))
 
+    coupled = any("sub_iterations" in r for r in rows)
     lines = [f"# Study: `{os.path.relpath(study['scene'])}`", "",
              f"Error: {'against the analytic solution' if hasattr(measure, 'errors') else 'relative to the reference run'} "
              f"({', '.join(sorted({c[6:] for r in rows for c in r if c.startswith('error_')}))}); "
              f"{jobs} run(s) at a time, {threads} thread(s) each. * marks the Pareto front (no run both faster "
              "and more accurate).", "",
-             "| " + " | ".join(k.label for k in knobs) + " | wall [s] | error | |",
-             "|" + "---|" * (len(knobs) + 3)]
+             "| " + " | ".join(k.label for k in knobs) + (" | sub-iterations / window" if coupled else "") +
+             " | wall [s] | error | |",
+             "|" + "---|" * (len(knobs) + 3 + coupled)]
     for r in rows:
         cells = [short(r[k.label]) if r[k.label] != "" else "-" for k in knobs]
+        if coupled:
+            cells.append(f"{r['sub_iterations']:.2f}" if "sub_iterations" in r else "-")
         error = f"{r['error']:.3e}" if math.isfinite(r["error"]) else r["note"][:60]
         lines.append("| " + " | ".join(cells) + f" | {r['wall_s']:.2f} | {error} | {'*' if r['pareto'] else ''} |")
     if orders:

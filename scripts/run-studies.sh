@@ -1,13 +1,16 @@
 #!/bin/sh
-# Regenerates the shipped accuracy-against-time studies (cases/*/study.toml):
-# runs each with cases/study.py into results/study_<case>/ and copies its
-# table, plot and CSVs to cases/<case>/study/, which the README links.
-# About 15 minutes on 2 cores. Needs a build (scripts/run-main.sh makes one).
+# Regenerates the shipped studies: every cases/<case>/study.toml (accuracy
+# against time) and schemes.toml (coupling schemes and windows), each run with
+# cases/study.py into results/<case>_<spec>/, its table, plot and CSVs copied
+# to cases/<case>/<spec>/, which the READMEs link. About 9 minutes on 2 cores.
+# Needs a build (scripts/run-main.sh makes one).
 set -eu
 cd "$(dirname "$0")/.."
-for case in bar drainage terzaghi mandel outburst; do
-  out=results/study_$case
-  /usr/bin/python3 cases/study.py cases/$case/study.toml --out "$out"
-  mkdir -p cases/$case/study
-  cp "$out/study.md" "$out/study.png" "$out/study.csv" "$out/study_orders.csv" cases/$case/study/
+for spec in cases/*/study.toml cases/*/schemes.toml; do
+  case_dir=$(dirname "$spec")
+  name=$(basename "$spec" .toml)
+  out=results/$(basename "$case_dir")_$name
+  /usr/bin/python3 cases/study.py "$spec" --out "$out"
+  mkdir -p "$case_dir/$name"
+  cp "$out/study.md" "$out/study.png" "$out/study.csv" "$out/study_orders.csv" "$case_dir/$name/"
 done
