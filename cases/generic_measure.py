@@ -7,7 +7,7 @@ import os
 
 import numpy as np
 
-from run_output import last_snapshot, particle_state, seepage_state
+from run_output import particle_state, seepage_state
 
 
 def quantities(run_dir):

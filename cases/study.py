@@ -215,6 +215,7 @@ def program_path(program, build, study_dir):
 
 
 def run_one(program, scene, overrides, directory, threads):
+    """Runs a program on a scene with overrides; its wall time and, if it failed, its last message."""
     command = [program, scene, "-q", "-o", directory]
     for o in overrides:
         command += ["--set", o]

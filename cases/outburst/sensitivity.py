@@ -10,13 +10,15 @@ time: each uses every core), about 10 minutes on 2 cores.
 import argparse
 import csv
 import os
-import subprocess
-import time
+import sys
 
 import h5py
 import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.dirname(HERE))
+from study import run_one  # noqa: E402
+
 FACE = 25.0
 
 # (label, overrides): each row changes one choice of outburst.toml.
@@ -66,13 +68,11 @@ def main():
     rows = []
     for k, (label, overrides) in enumerate(VARIANTS):
         run_dir = os.path.join(args.out, f"run_{k:02d}")
-        command = [args.outburst, os.path.join(HERE, "outburst.toml"), "-q", "-o", run_dir,
-                   "--set", f'scene.end_time="{args.end_time}"']
-        for o in overrides:
-            command += ["--set", o]
-        start = time.monotonic()
-        subprocess.run(command, check=True)
-        row = {"variant": label, "wall_s": time.monotonic() - start, **headline(run_dir)}
+        wall, failure = run_one(args.outburst, os.path.join(HERE, "outburst.toml"),
+                                [f'scene.end_time="{args.end_time}"'] + overrides, run_dir, os.cpu_count() or 1)
+        if failure:
+            raise SystemExit(f"sensitivity: {label}: {failure}")
+        row = {"variant": label, "wall_s": wall, **headline(run_dir)}
         rows.append(row)
         print(f"{label}: {row}", flush=True)
     with open(os.path.join(args.out, "sensitivity.csv"), "w", newline="") as f:
