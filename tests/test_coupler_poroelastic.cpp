@@ -14,6 +14,12 @@ using namespace outburst;
 
 namespace {
 
+double mean_iterations(const coupling::CoupledModel& model) {
+  double sum = 0;
+  for (const auto& w : model.coupling().records()) sum += w.iterations;
+  return sum / static_cast<double>(model.coupling().records().size());
+}
+
 // Terzaghi: p(z, t) = sum 2 p0 / M_m sin(M_m z / H) exp(-M_m^2 T), z from the
 // drained top, M_m = pi (2m + 1) / 2, T = c_v t / H^2.
 struct Terzaghi {
@@ -78,8 +84,7 @@ Result run(const std::vector<std::string>& overrides) {
     r.settlement_error = std::max(r.settlement_error, std::abs(measured / expected - 1));
   }
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  for (const auto& w : model.coupling().records()) r.iterations += w.iterations;
-  r.iterations /= static_cast<double>(model.coupling().records().size());
+  r.iterations = mean_iterations(model);
   return r;
 }
 
@@ -140,9 +145,7 @@ TEST_CASE("Terzaghi on a ten times stiffer column: Aitken and IQN-ILS beat const
                                            "scene.end_time=\"0.2 s\""}));
     coupling::CoupledModel model(coupling::read_coupled_setup(doc->root()));
     while (model.coupling().time() < 0.2 - 1e-12) model.advance(0.2);
-    double sum = 0;
-    for (const auto& w : model.coupling().records()) sum += w.iterations;
-    return sum / static_cast<double>(model.coupling().records().size());
+    return mean_iterations(model);
   };
   const double constant = iterations("constant"), aitken = iterations("aitken"), iqn = iterations("iqn_ils");
   std::printf("\nstiff column, sub-iterations per window: constant %.2f, Aitken %.2f, IQN-ILS %.2f\n", constant,
@@ -267,8 +270,7 @@ MandelResult run_mandel(const std::vector<std::string>& overrides) {
     r.settlement_error = std::max(r.settlement_error, std::abs(settlement / exact.settlement(t_check) - 1));
   }
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  for (const auto& w : model.coupling().records()) r.iterations += w.iterations;
-  r.iterations /= static_cast<double>(model.coupling().records().size());
+  r.iterations = mean_iterations(model);
   return r;
 }
 
