@@ -215,7 +215,7 @@ def write_report(run, args, gradients, path):
     # Cavity: seam bins (0.5 m) that held coal at t = 0 and hold less than half
     # of it now, connected to the face.
     h = 0.5
-    ex = np.arange(face, 45.0 + 1e-9, h)
+    ex = np.arange(face, float(run.nodes[:, 0].max()) + 1e-9, h)
     ey = np.arange(0.0, args.top + 1e-9, h)
     full0, _, _ = np.histogram2d(x0[:, 0], x0[:, 1], bins=[ex, ey])
     full1, _, _ = np.histogram2d(x[:, 0], x[:, 1], bins=[ex, ey])
