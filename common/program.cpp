@@ -41,6 +41,13 @@ SceneHeader read_scene_header(const scene::Table& root) {
   if (h.solvers.empty()) s->fail("solvers", "name at least one solver: [\"seepage\"], [\"mpm\"] or both");
   h.end_time = s->quantity({"end_time", "simulated time at which the run stops", "", scene::Range::positive()},
                            units::time);
+  if (s->has("rest_fraction")) {
+    if (std::find(h.solvers.begin(), h.solvers.end(), "mpm") == h.solvers.end())
+      s->fail("rest_fraction", "the rest criterion watches the coal's kinetic energy: it needs the mpm solver");
+    h.rest_fraction = s->number({"rest_fraction",
+                                 "stop before end_time once the kinetic energy is below this fraction of its peak",
+                                 "", {0.0, 1.0, false, false}});
+  }
   const auto o = root.table("output", "what is written and how often", false);
   h.output_interval = h.end_time / 10;
   if (o && o->has("interval"))

@@ -7,8 +7,10 @@
 // and the one place that turns exceptions into exit codes: 2 for a bad scene or
 // command line (with the file, line and key), 1 for a run that failed.
 
+#include <algorithm>
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -42,8 +44,27 @@ struct SceneHeader {
   std::vector<std::string> solvers;  // which solvers run: "seepage", "mpm"
   double end_time;                   // [s]
   double output_interval;            // simulated time between snapshots [s]
+  // Stop before end_time once the kinetic energy falls below this fraction of
+  // its peak (scenes with the mpm solver): the coal has come to rest.
+  std::optional<double> rest_fraction;
 };
 SceneHeader read_scene_header(const scene::Table& root);
+
+// Watches a run's kinetic energy for the [scene] rest_fraction criterion.
+class RestWatch {
+ public:
+  explicit RestWatch(std::optional<double> fraction) : fraction_(fraction) {}
+  // True once `kinetic` [J] is below the fraction of the largest value seen so far.
+  bool at_rest(double kinetic) {
+    peak_ = std::max(peak_, kinetic);
+    return fraction_ && peak_ > 0 && kinetic < *fraction_ * peak_;
+  }
+  double peak() const { return peak_; }
+
+ private:
+  std::optional<double> fraction_;
+  double peak_ = 0;
+};
 
 // Stops with a clear error when a program is given a scene for other solvers.
 void require_solvers(const scene::Table& root, const SceneHeader& header,

@@ -71,6 +71,8 @@ int run(const RunOptions& options, scene::Document& doc) {
   double next_output = header.output_interval;
   long iterations = 0;
   const auto& coupler = model.coupling();
+  RestWatch rest(header.rest_fraction);
+  bool at_rest = false;
   while (coupler.time() < header.end_time * (1 - 1e-12)) {
     const double target = std::min(next_output, header.end_time);
     const auto& r = model.advance(target);
@@ -81,13 +83,19 @@ int run(const RunOptions& options, scene::Document& doc) {
               solid.energies().kinetic, solid.particles().size());
     progress.update(static_cast<long>(coupler.records().size()), coupler.time(), r.size,
                     fmt::format("sub-iterations {}", r.iterations));
-    if (coupler.time() >= target * (1 - 1e-12)) {
+    const bool output_due = coupler.time() >= target * (1 - 1e-12);
+    at_rest = rest.at_rest(solid.kinetic_energy());
+    if (output_due || at_rest) {
       seepage_out.snapshot(seepage_solver);
       solid_out.snapshot(solid);
-      next_output += header.output_interval;
+      if (output_due) next_output += header.output_interval;
     }
+    if (at_rest) break;
   }
   progress.finish();
+  if (at_rest)
+    spdlog::info("the coal is at rest at t = {:.4g} s: kinetic energy {:.3g} J/m, below {:g} of its peak {:.3g} J/m",
+                 coupler.time(), solid.kinetic_energy(), *header.rest_fraction, rest.peak());
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   spdlog::info("done: {} windows, {} sub-iterations, {} MPM steps, {:.3g} s wall; gas released {:.4g} m3/m, "
                "{} particles left the grid",

@@ -45,6 +45,8 @@ int run(const RunOptions& options, scene::Document& doc) {
   double last_snapshot_time = 0;
   Progress progress("mpm", 0.0, header.end_time, options.show_progress());
   double next_output = header.output_interval;
+  RestWatch rest(header.rest_fraction);
+  bool at_rest = false;
   while (solver.time() < header.end_time * (1 - 1e-12)) {
     const double target = std::min(next_output, header.end_time);
     const double dt = std::min(setup.fixed_time_step ? *setup.fixed_time_step : solver.stable_time_step(),
@@ -60,13 +62,19 @@ int run(const RunOptions& options, scene::Document& doc) {
       throw;
     }
     progress.update(solver.steps(), solver.time(), dt, fmt::format("particles {}", solver.particles().size()));
-    if (solver.time() >= target * (1 - 1e-12)) {
+    const bool output_due = solver.time() >= target * (1 - 1e-12);
+    at_rest = rest.at_rest(solver.kinetic_energy());
+    if (output_due || at_rest) {
       out.snapshot(solver);
       last_snapshot_time = solver.time();
-      next_output += header.output_interval;
+      if (output_due) next_output += header.output_interval;
     }
+    if (at_rest) break;
   }
   progress.finish();
+  if (at_rest)
+    spdlog::info("at rest at t = {:.4g} s: kinetic energy {:.3g} J/m, below {:g} of its peak {:.3g} J/m",
+                 solver.time(), solver.kinetic_energy(), *header.rest_fraction, rest.peak());
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   spdlog::info("done: {} steps, {:.3g} s wall, {:.3g} particle-steps/s, {} particles left the grid",
                solver.steps(), wall, static_cast<double>(solver.steps()) * static_cast<double>(solver.particles().size()) / wall,

@@ -87,6 +87,8 @@ TEST_CASE("broken scenes are rejected with file, line, key and what was expected
        {"seepage.regions[0].coal_density", "required key is missing"}},
       {replace(valid, "[[seepage.regions]]", "[[seepage.region]]"),
        {"seepage.regions", "give at least one [[seepage.regions]]"}},
+      {replace(valid, "end_time = \"1 d\"", "end_time = \"1 d\"\nrest_fraction = 0.01"),
+       {"broken.toml:4:17", "scene.rest_fraction", "needs the mpm solver"}},
       {replace(valid, "[scene]", "[scene\n"), {"broken.toml:1:", "not valid TOML"}},
       {replace(valid, "[seepage.mesh]\n", "[seepage.mesh]\ntype = \"gmsh\"\nfile = \"nowhere.msh\"\n"),
        {"seepage.mesh.file", "does not exist"}},
