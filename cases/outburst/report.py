@@ -70,9 +70,9 @@ def panel_grid(count, title, size=(11, 2.0)):
     return fig, np.atleast_1d(axes)
 
 
-def draw_rock(ax, face, floor, roof, top):
-    ax.add_patch(plt.Rectangle((0, 0), face, floor, color="0.75", zorder=0))
-    ax.add_patch(plt.Rectangle((0, roof), face, top - roof, color="0.75", zorder=0))
+def draw_rock(ax, left, face, floor, roof, top):
+    ax.add_patch(plt.Rectangle((left, 0), face - left, floor, color="0.75", zorder=0))
+    ax.add_patch(plt.Rectangle((left, roof), face - left, top - roof, color="0.75", zorder=0))
 
 
 def particle_figure(run, picks, field, label, path, geometry, cmap="viridis", vmin=None, vmax=None):
@@ -80,12 +80,12 @@ def particle_figure(run, picks, field, label, path, geometry, cmap="viridis", vm
     for ax, k in zip(axes, picks):
         p = run.particles(k)
         values = field(p)
-        draw_rock(ax, *geometry[:4])
+        draw_rock(ax, *geometry[:5])
         sc = ax.scatter(p["points"][:, 0], p["points"][:, 1], c=values, s=1.5, cmap=cmap, vmin=vmin, vmax=vmax,
                         linewidths=0)
         ax.set_aspect("equal")
-        ax.set_xlim(0, geometry[4])
-        ax.set_ylim(0, geometry[3])
+        ax.set_xlim(geometry[0], geometry[5])
+        ax.set_ylim(0, geometry[4])
         ax.set_title(f"t = {run.times[k]:.3g} s (snapshot {k})", fontsize=9)
         fig.colorbar(sc, ax=ax, shrink=0.9)
     axes[-1].set_xlabel("x [m]")
@@ -103,8 +103,9 @@ def main():
     args = ap.parse_args()
     run = Run(args.results)
     face, floor, roof, top = args.face, args.tunnel_floor, args.tunnel_roof, args.top
-    width = float(run.nodes[:, 0].max())
-    geometry = (face, floor, roof, top, width)
+    # The tunnel runs from the model's left edge to the face.
+    left, width = float(run.nodes[:, 0].min()), float(run.nodes[:, 0].max())
+    geometry = (left, face, floor, roof, top, width)
     out = lambda name: os.path.join(args.results, name)
     picks = five(len(run.particle_files))
     seep_picks = five(len(run.seepage_files))
@@ -117,8 +118,8 @@ def main():
         coll = PolyCollection(polys, array=p[run.cells].mean(axis=1), cmap="jet", edgecolors="none")
         coll.set_clim(0, 3.0)
         ax.add_collection(coll)
-        draw_rock(ax, *geometry[:4])
-        ax.set_xlim(0, width)
+        draw_rock(ax, *geometry[:5])
+        ax.set_xlim(left, width)
         ax.set_ylim(0, top)
         ax.set_aspect("equal")
         ax.set_title(f"t = {run.seepage_times[k]:.3g} s", fontsize=9)
@@ -206,11 +207,11 @@ def write_report(run, args, gradients, path):
             start_time = run.times[k]
             start_height = float(np.median(p[out, 1]))
             break
-    # Pile: height of the coal above the tunnel floor in 1 m bins in front of the face.
-    bins = np.arange(0, face + 1e-9, 1.0)
+    # Pile: height of the coal above the tunnel floor in 1 m bins from the face
+    # out to the farthest coal.
     heights = []
-    for a in bins[:-1]:
-        sel = ejected & (x[:, 0] >= a) & (x[:, 0] < a + 1)
+    for d in np.arange(0.0, farthest, 1.0):
+        sel = ejected & (x[:, 0] < face - d) & (x[:, 0] >= face - d - 1)
         heights.append(x[sel, 1].max() - floor if sel.any() else 0.0)
     # Cavity: seam bins (0.5 m) that held coal at t = 0 and hold less than half
     # of it now, connected to the face.
@@ -234,6 +235,18 @@ def write_report(run, args, gradients, path):
     cavity_depth = (np.nonzero(cavity.any(axis=1))[0].max() + 1) * h if cavity.any() else 0.0
     cavity_height = cavity.sum(axis=1).max() * h if cavity.any() else 0.0
     mouth = cavity[0].sum() * h
+    # Loosened coal: seam bins of 1 m that held coal at t = 0 and hold less than
+    # 95 % of it now (the void the ejected coal left, spread out).
+    ex1, ey1 = np.arange(face, ex[-1] + 1e-9, 1.0), np.arange(0.0, args.top + 1e-9, 1.0)
+    held0, _, _ = np.histogram2d(x0[:, 0], x0[:, 1], bins=[ex1, ey1])
+    held1, _, _ = np.histogram2d(x[:, 0], x[:, 1], bins=[ex1, ey1])
+    loose = (held0 > 0) & (held1 < 0.95 * held0)
+    loose_area = loose.sum() * 1.0
+    loose_fill = held1[loose].sum() / held0[loose].sum() if loose.any() else 1.0
+    loose_depth = (np.nonzero(loose.any(axis=1))[0].max() + 1) * 1.0 if loose.any() else 0.0
+    # At rest: the kinetic energy at the end against its peak.
+    kinetic = run.coupling["kinetic_energy"]
+    rest_ratio = kinetic[-1] / kinetic.max() if kinetic.max() > 0 else 0.0
     e = run.history[-1]
     released = run.coupling["gas_released"][-1]
     damaged = (last["damage"].ravel() > 0).mean()
@@ -243,7 +256,8 @@ def write_report(run, args, gradients, path):
         "# Outburst case: measured figures beside the paper's",
         "",
         f"Run: `{os.path.abspath(run.dir)}`, {run.times[-1]:.3g} s simulated, "
-        f"{len(x0)} particles, {len(run.cells)} seepage cells.",
+        f"{len(x0)} particles, {len(run.cells)} seepage cells; kinetic energy at the end "
+        f"{rest_ratio:.1%} of its peak.",
         "",
         "| quantity | this run | paper |",
         "|---|---|---|",
@@ -263,13 +277,16 @@ def write_report(run, args, gradients, path):
         f"| coal in front of the face | {ejected.sum()} particles ({ejected.mean():.1%}) | - |",
         f"| cavity (seam emptied to < half, connected to the face) | {cavity_area:.3g} m2, {cavity_depth:.3g} m "
         f"deep, {cavity_height:.3g} m at its highest, mouth {mouth:.3g} m | a large cavity with a small opening |",
+        f"| loosened seam coal (1 m bins holding < 95 % of their coal) | {loose_area:.3g} m2 to {loose_depth:.3g} m "
+        f"deep, at {loose_fill:.0%} of its initial density | - |",
         f"| damaged / fully damaged coal | {damaged:.1%} / {broken:.1%} | damage spreads from the face inward |",
         f"| gas released into the tunnel | {released:.4g} m3 per m of depth (at the model's pressure) | - |",
         f"| steepest pressure drop on the tunnel axis | {g[1, 1]:.3g} MPa/m at {g[1, 0]:.3g} s ({g[1, 2]:.3g} m "
         f"into the seam), {g[-1, 1]:.3g} MPa/m at {g[-1, 0]:.3g} s ({g[-1, 2]:.3g} m) | largest at the face, "
         "easing with time |",
         "",
-        "Pile height above the tunnel floor per metre in front of the face (x = 0..1 m first):",
+        "Pile height above the tunnel floor [m] per metre from the face out to the farthest coal "
+        "(0..1 m from the face first):",
         "",
         "    " + " ".join(f"{v:.2f}" for v in heights),
         "",
