@@ -1,7 +1,8 @@
 // Gas seepage domain of the outburst case: the coal seam (20 m deep, 9 m high,
-// right) and the tunnel in front of its face (25 m long unless set, 3 m high, left, between
-// the roof and floor rock, which carry no gas). Structured quadrilaterals of
-// 0.5 m so that the face and the tunnel walls lie on element edges.
+// right) and the tunnel in front of its face (3 m high, 25 m long unless
+// `tunnel` is set, left, between the roof and floor rock, which carry no gas).
+// Structured quadrilaterals of 0.5 m so that the face and the tunnel walls lie
+// on element edges.
 // Regenerate: gmsh -2 -format msh41 seam.geo -o seam.msh
 // and the 100 m tunnel of the run to rest (README.md):
 // gmsh -2 -format msh41 -setnumber tunnel 100 seam.geo -o seam_long.msh
