@@ -183,6 +183,25 @@ def main():
     write_report(run, args, gradients, out("report.md"))
 
 
+def pile_and_seam_figure(heights, ex, ey, fill, time, tunnel_height, path):
+    """Where the coal ended up: the pile in the tunnel and what is left in the seam."""
+    fig, (top, bottom) = plt.subplots(2, 1, figsize=(9, 6.5), constrained_layout=True)
+    top.bar(np.arange(len(heights)) + 0.5, heights, width=1.0, color="0.3")
+    top.set_xlim(0, max(len(heights), 1))
+    top.set_ylim(0, tunnel_height * 1.1)
+    top.set_xlabel("distance from the excavation face [m]")
+    top.set_ylabel("pile height [m]")
+    top.set_title(f"Coal pile in the tunnel at t = {time:.3g} s")
+    mesh = bottom.pcolormesh(ex, ey, fill.T, cmap="viridis", vmin=0, vmax=1)
+    bottom.set_aspect("equal")
+    bottom.set_xlabel("x [m]")
+    bottom.set_ylabel("y [m]")
+    bottom.set_title("Coal left in the seam per 1 m bin, of that at t = 0 (a cavity shows as 0)")
+    fig.colorbar(mesh, ax=bottom, shrink=0.8)
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+
+
 def write_report(run, args, gradients, path):
     face, floor, roof = args.face, args.tunnel_floor, args.tunnel_roof
     tr = run.tracers
@@ -244,6 +263,8 @@ def write_report(run, args, gradients, path):
     loose_area = loose.sum() * 1.0
     loose_fill = held1[loose].sum() / held0[loose].sum() if loose.any() else 1.0
     loose_depth = (np.nonzero(loose.any(axis=1))[0].max() + 1) * 1.0 if loose.any() else 0.0
+    pile_and_seam_figure(heights, ex1, ey1, np.where(held0 > 0, held1 / np.maximum(held0, 1), np.nan),
+                         run.times[-1], roof - floor, os.path.join(os.path.dirname(path), "fig10_pile_and_seam.png"))
     # At rest: the kinetic energy at the end against its peak.
     kinetic = run.coupling["kinetic_energy"]
     rest_ratio = kinetic[-1] / kinetic.max() if kinetic.max() > 0 else 0.0
@@ -304,7 +325,7 @@ def write_report(run, args, gradients, path):
         "",
         "Figures: fig3_pressure.png, fig4_pressure_profile.png, fig5_damage.png, "
         "fig6_min_principal_stress.png, fig7_velocity.png, fig8_tracer_velocity.png, "
-        "fig9_tracer_displacement.png.",
+        "fig9_tracer_displacement.png, fig10_pile_and_seam.png (the pile and the coal left in the seam).",
     ]
     with open(path, "w") as f:
         f.write("\n".join(lines) + "\n")
