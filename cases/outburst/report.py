@@ -273,6 +273,7 @@ def write_report(run, args, gradients, path):
     damaged = (last["damage"].ravel() > 0).mean()
     broken = (last["damage"].ravel() >= 0.99).mean()
     g = np.array(gradients)
+    steps = np.unique(np.linspace(1, len(g) - 1, min(len(g) - 1, 10)).round().astype(int))
     lines = [
         "# Outburst case: measured figures beside the paper's",
         "",
@@ -310,6 +311,13 @@ def write_report(run, args, gradients, path):
         "(0..1 m from the face first):",
         "",
         "    " + " ".join(f"{v:.2f}" for v in heights),
+        "",
+        "Steepest pressure drop on the tunnel axis over time (where it sits: metres into the seam):",
+        "",
+        "| t [s] | " + " | ".join(f"{t:.3g}" for t in g[steps, 0]) + " |",
+        "|---|" + "---|" * len(steps),
+        "| drop [MPa/m] | " + " | ".join(f"{v:.3g}" for v in g[steps, 1]) + " |",
+        "| at [m] | " + " | ".join(f"{v:.3g}" for v in g[steps, 2]) + " |",
         "",
         "## Energy budget (J per m of depth, at the end)",
         "",
