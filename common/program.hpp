@@ -60,6 +60,8 @@ class RestWatch {
     return fraction_ && peak_ > 0 && kinetic < *fraction_ * peak_;
   }
   double peak() const { return peak_; }
+  // Without the criterion a run needs no kinetic energy summed per step.
+  bool active() const { return fraction_.has_value(); }
 
  private:
   std::optional<double> fraction_;

@@ -84,7 +84,7 @@ int run(const RunOptions& options, scene::Document& doc) {
     progress.update(static_cast<long>(coupler.records().size()), coupler.time(), r.size,
                     fmt::format("sub-iterations {}", r.iterations));
     const bool output_due = coupler.time() >= target * (1 - 1e-12);
-    at_rest = rest.at_rest(solid.kinetic_energy());
+    at_rest = rest.active() && rest.at_rest(solid.kinetic_energy());
     if (output_due || at_rest) {
       seepage_out.snapshot(seepage_solver);
       solid_out.snapshot(solid);

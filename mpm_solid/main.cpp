@@ -63,7 +63,7 @@ int run(const RunOptions& options, scene::Document& doc) {
     }
     progress.update(solver.steps(), solver.time(), dt, fmt::format("particles {}", solver.particles().size()));
     const bool output_due = solver.time() >= target * (1 - 1e-12);
-    at_rest = rest.at_rest(solver.kinetic_energy());
+    at_rest = rest.active() && rest.at_rest(solver.kinetic_energy());
     if (output_due || at_rest) {
       out.snapshot(solver);
       last_snapshot_time = solver.time();
