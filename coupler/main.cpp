@@ -79,12 +79,13 @@ int run(const RunOptions& options, scene::Document& doc) {
     iterations += r.iterations;
     solid_out.history(solid, model.solid_side().last_window());
     seepage_out.history(seepage_solver, r.size, model.seepage_side().last_report());
+    const double kinetic = solid.kinetic_energy();
     log.write(coupler.records().size(), r, model.seepage_side().open_cells(), seepage_solver.balance().total_outflow(),
-              solid.energies().kinetic, solid.particles().size());
+              kinetic, solid.particles().size());
     progress.update(static_cast<long>(coupler.records().size()), coupler.time(), r.size,
                     fmt::format("sub-iterations {}", r.iterations));
     const bool output_due = coupler.time() >= target * (1 - 1e-12);
-    at_rest = rest.active() && rest.at_rest(solid.kinetic_energy());
+    at_rest = rest.at_rest(kinetic);
     if (output_due || at_rest) {
       seepage_out.snapshot(seepage_solver);
       solid_out.snapshot(solid);

@@ -202,6 +202,14 @@ def pile_and_seam_figure(heights, ex, ey, fill, time, tunnel_height, path):
     plt.close(fig)
 
 
+def seam_bins(x0, x, face, right, top, h):
+    """Square bins of edge h over the seam (face..right, 0..top): their edges and
+    the particles in each at t = 0 (x0) and now (x)."""
+    ex, ey = np.arange(face, right + 1e-9, h), np.arange(0.0, top + 1e-9, h)
+    return (ex, ey, np.histogram2d(x0[:, 0], x0[:, 1], bins=[ex, ey])[0],
+            np.histogram2d(x[:, 0], x[:, 1], bins=[ex, ey])[0])
+
+
 def write_report(run, args, gradients, path):
     face, floor, roof = args.face, args.tunnel_floor, args.tunnel_roof
     tr = run.tracers
@@ -234,11 +242,9 @@ def write_report(run, args, gradients, path):
         heights.append(x[sel, 1].max() - floor if sel.any() else 0.0)
     # Cavity: seam bins (0.5 m) that held coal at t = 0 and hold less than half
     # of it now, connected to the face.
+    right = float(run.nodes[:, 0].max())
     h = 0.5
-    ex = np.arange(face, float(run.nodes[:, 0].max()) + 1e-9, h)
-    ey = np.arange(0.0, args.top + 1e-9, h)
-    full0, _, _ = np.histogram2d(x0[:, 0], x0[:, 1], bins=[ex, ey])
-    full1, _, _ = np.histogram2d(x[:, 0], x[:, 1], bins=[ex, ey])
+    _, _, full0, full1 = seam_bins(x0, x, face, right, args.top, h)
     emptied = (full0 > 0) & (full1 < 0.5 * full0)
     cavity = np.zeros_like(emptied)
     front = [(0, j) for j in range(emptied.shape[1]) if emptied[0, j]]
@@ -256,9 +262,7 @@ def write_report(run, args, gradients, path):
     mouth = cavity[0].sum() * h
     # Loosened coal: seam bins of 1 m that held coal at t = 0 and hold less than
     # 95 % of it now (the void the ejected coal left, spread out).
-    ex1, ey1 = np.arange(face, ex[-1] + 1e-9, 1.0), np.arange(0.0, args.top + 1e-9, 1.0)
-    held0, _, _ = np.histogram2d(x0[:, 0], x0[:, 1], bins=[ex1, ey1])
-    held1, _, _ = np.histogram2d(x[:, 0], x[:, 1], bins=[ex1, ey1])
+    ex1, ey1, held0, held1 = seam_bins(x0, x, face, right, args.top, 1.0)
     loose = (held0 > 0) & (held1 < 0.95 * held0)
     loose_area = loose.sum() * 1.0
     loose_fill = held1[loose].sum() / held0[loose].sum() if loose.any() else 1.0

@@ -5,7 +5,7 @@ paper does not give, and to resolution.
 usage: sensitivity.py [--outburst build/coupler/outburst] [--out results/outburst_sensitivity]
                       [--end-time "1 s"]
 writes OUT/sensitivity.md and OUT/sensitivity.csv; one run per row (one at a
-time: each uses every core), about 12 minutes on 2 cores.
+time: each uses every core), about 8 minutes on 2 cores.
 """
 import argparse
 import csv
