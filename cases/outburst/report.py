@@ -210,6 +210,39 @@ def seam_bins(x0, x, face, right, top, h):
             np.histogram2d(x[:, 0], x[:, 1], bins=[ex, ey])[0])
 
 
+def cavity(full0, full1, h):
+    """The cavity in the seam's bins of edge h (particles per bin at t = 0 and
+    now, the first row of bins at the face): the bins that held coal and hold
+    less than half of it now, connected to the face. Its area, depth from the
+    face, largest height and mouth on the face, in metres."""
+    emptied = (full0 > 0) & (full1 < 0.5 * full0)
+    inside = np.zeros_like(emptied)
+    front = [(0, j) for j in range(emptied.shape[1]) if emptied[0, j]]
+    while front:
+        i, j = front.pop()
+        if inside[i, j]:
+            continue
+        inside[i, j] = True
+        for a, b in ((i + 1, j), (i - 1, j), (i, j + 1), (i, j - 1)):
+            if 0 <= a < emptied.shape[0] and 0 <= b < emptied.shape[1] and emptied[a, b] and not inside[a, b]:
+                front.append((a, b))
+    if not inside.any():
+        return {"area": 0.0, "depth": 0.0, "height": 0.0, "mouth": 0.0}
+    return {"area": inside.sum() * h * h, "depth": (np.nonzero(inside.any(axis=1))[0].max() + 1) * h,
+            "height": inside.sum(axis=1).max() * h, "mouth": inside[0].sum() * h}
+
+
+def loosened(held0, held1, h):
+    """The loosened seam coal: bins of edge h that hold less than 95 % of their
+    coal at t = 0 (the void the ejected coal left, spread out). Their area,
+    depth from the face and the share of the coal they still hold."""
+    loose = (held0 > 0) & (held1 < 0.95 * held0)
+    if not loose.any():
+        return {"area": 0.0, "depth": 0.0, "fill": 1.0}
+    return {"area": loose.sum() * h * h, "depth": (np.nonzero(loose.any(axis=1))[0].max() + 1) * h,
+            "fill": held1[loose].sum() / held0[loose].sum()}
+
+
 def write_report(run, args, gradients, path):
     face, floor, roof = args.face, args.tunnel_floor, args.tunnel_roof
     tr = run.tracers
@@ -240,33 +273,10 @@ def write_report(run, args, gradients, path):
     for d in np.arange(0.0, farthest, 1.0):
         sel = ejected & (x[:, 0] < face - d) & (x[:, 0] >= face - d - 1)
         heights.append(x[sel, 1].max() - floor if sel.any() else 0.0)
-    # Cavity: seam bins (0.5 m) that held coal at t = 0 and hold less than half
-    # of it now, connected to the face.
     right = float(run.nodes[:, 0].max())
-    h = 0.5
-    _, _, full0, full1 = seam_bins(x0, x, face, right, args.top, h)
-    emptied = (full0 > 0) & (full1 < 0.5 * full0)
-    cavity = np.zeros_like(emptied)
-    front = [(0, j) for j in range(emptied.shape[1]) if emptied[0, j]]
-    while front:
-        i, j = front.pop()
-        if cavity[i, j]:
-            continue
-        cavity[i, j] = True
-        for a, b in ((i + 1, j), (i - 1, j), (i, j + 1), (i, j - 1)):
-            if 0 <= a < emptied.shape[0] and 0 <= b < emptied.shape[1] and emptied[a, b] and not cavity[a, b]:
-                front.append((a, b))
-    cavity_area = cavity.sum() * h * h
-    cavity_depth = (np.nonzero(cavity.any(axis=1))[0].max() + 1) * h if cavity.any() else 0.0
-    cavity_height = cavity.sum(axis=1).max() * h if cavity.any() else 0.0
-    mouth = cavity[0].sum() * h
-    # Loosened coal: seam bins of 1 m that held coal at t = 0 and hold less than
-    # 95 % of it now (the void the ejected coal left, spread out).
+    cav = cavity(*seam_bins(x0, x, face, right, args.top, 0.5)[2:], 0.5)
     ex1, ey1, held0, held1 = seam_bins(x0, x, face, right, args.top, 1.0)
-    loose = (held0 > 0) & (held1 < 0.95 * held0)
-    loose_area = loose.sum() * 1.0
-    loose_fill = held1[loose].sum() / held0[loose].sum() if loose.any() else 1.0
-    loose_depth = (np.nonzero(loose.any(axis=1))[0].max() + 1) * 1.0 if loose.any() else 0.0
+    loose = loosened(held0, held1, 1.0)
     pile_and_seam_figure(heights, ex1, ey1, np.where(held0 > 0, held1 / np.maximum(held0, 1), np.nan),
                          run.times[-1], roof - floor, os.path.join(os.path.dirname(path), "fig10_pile_and_seam.png"))
     # At rest: the kinetic energy at the end against its peak.
@@ -301,10 +311,11 @@ def write_report(run, args, gradients, path):
         f"| farthest coal from the face | {farthest:.3g} m ({removed} particles left the grid at the tunnel's "
         f"end) | 20 m |",
         f"| coal in front of the face | {ejected.sum()} particles ({ejected.mean():.1%}) | - |",
-        f"| cavity (seam emptied to < half, connected to the face) | {cavity_area:.3g} m2, {cavity_depth:.3g} m "
-        f"deep, {cavity_height:.3g} m at its highest, mouth {mouth:.3g} m | a large cavity with a small opening |",
-        f"| loosened seam coal (1 m bins holding < 95 % of their coal) | {loose_area:.3g} m2 to {loose_depth:.3g} m "
-        f"deep, at {loose_fill:.0%} of its initial density | - |",
+        f"| cavity (seam emptied to < half, connected to the face) | {cav['area']:.3g} m2, {cav['depth']:.3g} m "
+        f"deep, {cav['height']:.3g} m at its highest, mouth {cav['mouth']:.3g} m | a large cavity with a small "
+        "opening |",
+        f"| loosened seam coal (1 m bins holding < 95 % of their coal) | {loose['area']:.3g} m2 to "
+        f"{loose['depth']:.3g} m deep, at {loose['fill']:.0%} of its initial density | - |",
         f"| damaged / fully damaged coal | {damaged:.1%} / {broken:.1%} | damage spreads from the face inward |",
         f"| gas released into the tunnel | {released:.4g} m3 per m of depth (at the model's pressure) | - |",
         f"| steepest pressure drop on the tunnel axis | {g[1, 1]:.3g} MPa/m at {g[1, 0]:.3g} s ({g[1, 2]:.3g} m "
