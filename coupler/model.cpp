@@ -1,6 +1,7 @@
 #include "coupler/model.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 #include <fmt/format.h>
@@ -21,22 +22,27 @@ CoupledSetup read_coupled_setup(scene::Table root) {
   if (s.coupling.gas_solid.biot_storage && s.seepage.model.law != seepage::Law::linear)
     coupling->fail("biot_storage", "the Biot storage term is written for the linear Darcy law: set seepage.law = "
                                    "\"linear\" or drop the key");
-  // Every seepage cell the coal fills must hold a particle: an empty one reads
-  // as open space and misses the coal's volume change (measured: Mandel's
-  // pressure grows without bound with particles 0.0625 m apart on 0.05 m cells).
+  // Every seepage cell the coal fills must read as coal: one without a
+  // particle, or with fewer than open_below of its area in particles, reads as
+  // open space and misses the coal's volume change (measured: Mandel's
+  // pressure grows without bound with particles 0.0625 m apart on 0.05 m
+  // cells; the outburst's seam opened whole with particles 1/6 m apart on
+  // 0.25 m cells, one to a row in some: 44 % full).
   double spacing = 0, narrowest = std::numeric_limits<double>::infinity();
   for (double w : s.solid.particles.half_width) spacing = std::max(spacing, 2 * w * s.solid.grid.h);
   for (std::size_t c = 0; c < s.seepage.mesh.num_cells(); ++c) {
     const auto x = s.seepage.mesh.corners(c);
     for (int k = 0; k < 4; ++k) narrowest = std::min(narrowest, (x[(k + 1) % 4] - x[k]).norm());
   }
-  if (spacing > narrowest * (1 + 1e-9))
+  const double per_row = std::floor(narrowest / spacing * (1 + 1e-9));
+  const double least_fill = std::pow(per_row * spacing / narrowest, 2);
+  if (per_row < 1 || least_fill < s.coupling.gas_solid.open_below)
     root.table("mpm", "", true)->fail(
-        "grid.cell_size", fmt::format("particles {:.4g} m apart cannot fill seepage cells {:.4g} m wide (cells "
-                                      "without a particle read as open space and miss the coal's volume change): "
-                                      "refine the MPM (grid.cell_size, bodies' particles_per_cell) or coarsen the "
-                                      "seepage mesh",
-                                      spacing, narrowest));
+        "grid.cell_size",
+        fmt::format("particles {:.4g} m apart fill a seepage cell {:.4g} m wide to as little as {:.0f} % (cells "
+                    "below coupling.open_below = {:g} read as open space and miss the coal's volume change): "
+                    "refine the MPM (grid.cell_size, bodies' particles_per_cell) or coarsen the seepage mesh",
+                    spacing, narrowest, 100 * least_fill, s.coupling.gas_solid.open_below));
   return s;
 }
 

@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "common/program.hpp"
+#include "coupler/model.hpp"
 #include "coupler/scene_reader.hpp"
 #include "mpm_solid/scene_reader.hpp"
 #include "seepage_fe/scene_reader.hpp"
@@ -31,4 +32,19 @@ TEST_CASE("shipped scenes are valid", "[scene][cases]") {
     ++checked;
   }
   CHECK(checked >= 2);
+}
+
+TEST_CASE("a coupled scene whose particles leave seepage cells reading as open space is refused", "[scene][coupling]") {
+  const std::string scene = std::string(OUTBURST_SOURCE_DIR) + "/cases/outburst/outburst.toml";
+  const auto setup = [&](const std::string& per_cell) {
+    auto doc = scene::Document::load(scene, {"mpm.bodies[0].particles_per_cell=" + per_cell});
+    return coupling::read_coupled_setup(doc->root());
+  };
+  // 1/3 m cells: 2 and 3 particles per cell fill every 0.5 m seepage cell to
+  // 100 % and 79 % at least; 1 per cell (1/3 m apart) some to 44 %, below
+  // open_below = 0.5.
+  REQUIRE_NOTHROW(setup("2"));
+  REQUIRE_NOTHROW(setup("3"));
+  REQUIRE_THROWS_WITH(setup("1"), Catch::Contains("mpm.grid.cell_size") &&
+                                      Catch::Contains("fill a seepage cell 0.5 m wide to as little as 44 %"));
 }
