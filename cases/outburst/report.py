@@ -130,18 +130,13 @@ def main():
 
     # Fig. 4: pressure against distance from the face, along the tunnel's axis.
     mid = 0.5 * (floor + roof)
-    row = np.where((np.abs(run.nodes[:, 1] - mid) < 1e-6) & (run.nodes[:, 0] >= face - 1e-9))[0]
-    row = row[np.argsort(run.nodes[row, 0])]
+    row = axis_row(run.nodes, face, mid)
     fig, ax = plt.subplots(figsize=(6.5, 4.2), constrained_layout=True)
     gradients = []
     for k in range(len(run.seepage_files)):
         p = run.pressure(k)[row] / MPA
         distance = run.nodes[row, 0] - face
-        # The face recedes as coal leaves: the steepest drop along the axis is
-        # where the coal face stands.
-        slope = np.diff(p) / np.diff(distance)
-        steepest = int(np.argmax(slope))
-        gradients.append((run.seepage_times[k], slope[steepest], distance[steepest]))
+        gradients.append((run.seepage_times[k], *steepest_drop(p, distance)))
         if k in seep_picks or k == 0:
             ax.plot(distance, p, marker=".", label=f"t = {run.seepage_times[k]:.3g} s")
     ax.set_xlabel("distance from the excavation face [m]")
@@ -200,6 +195,21 @@ def pile_and_seam_figure(heights, ex, ey, fill, time, tunnel_height, path):
     fig.colorbar(mesh, ax=bottom, shrink=0.8)
     fig.savefig(path, dpi=130)
     plt.close(fig)
+
+
+def axis_row(nodes, face, mid):
+    """The seepage nodes on the tunnel's axis (y = mid) from the face inward, in order."""
+    row = np.where((np.abs(nodes[:, 1] - mid) < 1e-6) & (nodes[:, 0] >= face - 1e-9))[0]
+    return row[np.argsort(nodes[row, 0])]
+
+
+def steepest_drop(p, distance):
+    """The steepest drop of p along the axis (per metre) and how far in it
+    starts. The face recedes as coal leaves: the steepest drop is where the
+    coal face stands."""
+    slope = np.diff(p) / np.diff(distance)
+    k = int(np.argmax(slope))
+    return slope[k], distance[k]
 
 
 def seam_bins(x0, x, face, right, top, h):

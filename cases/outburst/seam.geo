@@ -1,13 +1,13 @@
 // Gas seepage domain of the outburst case: the coal seam (20 m deep, 9 m high,
 // right) and the tunnel in front of its face (3 m high, 25 m long unless
 // `tunnel` is set, left, between the roof and floor rock, which carry no gas).
-// Structured quadrilaterals of 0.5 m so that the face and the tunnel walls lie
-// on element edges.
+// Structured quadrilaterals of h = 0.5 m so that the face and the tunnel walls
+// lie on element edges (sensitivity.py meshes h = 0.25 m too).
 // Regenerate: gmsh -2 -format msh41 seam.geo -o seam.msh
 // and the 100 m tunnel of the run to rest (README.md):
 // gmsh -2 -format msh41 -setnumber tunnel 100 seam.geo -o seam_long.msh
 // (committed meshes made with Gmsh 4.8.4, Debian 12's package)
-h = 0.5;
+DefineConstant[ h = 0.5 ];  // element edge [m]
 DefineConstant[ tunnel = 25 ];  // tunnel length [m]; the face stays at x = 25 m
 Point(1) = {25, 0, 0};  Point(2) = {45, 0, 0};  Point(3) = {45, 3, 0};  Point(4) = {45, 6, 0};
 Point(5) = {45, 9, 0};  Point(6) = {25, 9, 0};  Point(7) = {25, 6, 0};  Point(8) = {25, 3, 0};
