@@ -13,16 +13,14 @@ import os
 import subprocess
 import sys
 
-import h5py
-import numpy as np
-
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.dirname(HERE))
 sys.path.insert(0, HERE)
-from report import axis_row, steepest_drop  # noqa: E402
+from report import MPA, Run, axis_row, steepest_drop  # noqa: E402
 from study import run_one  # noqa: E402
 
 FACE = 25.0
+TUNNEL_AXIS = 4.5  # between the floor (3 m) and the roof (6 m)
 
 # (label, overrides): each row changes one choice of outburst.toml.
 VARIANTS = [
@@ -57,31 +55,22 @@ def fine_mesh(out):
 
 
 def headline(directory):
-    tr = np.genfromtxt(os.path.join(directory, "tracers.csv"), delimiter=",", names=True)
+    run = Run(directory)
+    tr = run.tracers
     speed = {k: tr["speed_m_per_s"][tr["tracer"] == k].max() for k in range(3)}
-    files = sorted(f for f in os.listdir(directory) if f.startswith("particles_") and f.endswith(".h5"))
-    with h5py.File(os.path.join(directory, files[-1])) as f:
-        x = f["particles/points"][:]
-        damage = f["particles/damage"][:].ravel()
+    last = run.particles(-1)
+    x, damage = last["points"], last["damage"].ravel()
     ejected = x[:, 0] < FACE
-    coupling = np.genfromtxt(os.path.join(directory, "coupling.csv"), delimiter=",", names=True)
-    history = np.genfromtxt(os.path.join(directory, "mpm_history.csv"), delimiter=",", names=True)
     # The steepest pressure drop on the tunnel's axis at the first output and the last.
-    with h5py.File(os.path.join(directory, "seepage_mesh.h5")) as f:
-        nodes = f["nodes"][:, :2]
-    row = axis_row(nodes, FACE, 4.5)
-    seepage = sorted(f for f in os.listdir(directory) if f.startswith("seepage_0") and f.endswith(".h5"))
-    drops = []
-    for name in (seepage[1], seepage[-1]):
-        with h5py.File(os.path.join(directory, name)) as f:
-            drops.append(steepest_drop(f["mesh/p"][:][row] / 1e6, nodes[row, 0] - FACE)[0])
+    row = axis_row(run.nodes, FACE, TUNNEL_AXIS)
+    drops = [steepest_drop(run.pressure(k)[row] / MPA, run.nodes[row, 0] - FACE)[0] for k in (1, -1)]
     return {
         "centre_m_per_s": speed[1], "top_m_per_s": speed[0], "bottom_m_per_s": speed[2],
         "farthest_m": FACE - x[:, 0].min() if ejected.any() else 0.0,
         "ejected_fraction": ejected.mean(),
         "fully_damaged_fraction": (damage >= 0.99).mean(),
-        "gas_released_m3_per_m": coupling["gas_released"][-1],
-        "left_grid": int(history["removed_total"][-1]),
+        "gas_released_m3_per_m": run.coupling["gas_released"][-1],
+        "left_grid": int(run.history["removed_total"][-1]),
         "first_drop_MPa_per_m": drops[0], "last_drop_MPa_per_m": drops[1],
     }
 
