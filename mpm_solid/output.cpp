@@ -23,7 +23,8 @@ Output::Output(const std::filesystem::path& directory, const output::RunInfo& in
   series_.add_point_grid("particles");
   history_.open(directory / "mpm_history.csv", std::ios::trunc);
   history_ << "step,time_s,dt_s,particles,removed_total,kinetic_J_per_m,strain_J_per_m,gravity_J_per_m,"
-              "plastic_J_per_m,damage_J_per_m,damping_J_per_m,walls_J_per_m,external_work_J_per_m,balance_error_J_per_m\n";
+              "plastic_J_per_m,damage_J_per_m,damping_J_per_m,walls_J_per_m,transfer_J_per_m,left_grid_J_per_m,"
+              "external_work_J_per_m,balance_error_J_per_m\n";
   history_.flush();
 }
 
@@ -65,11 +66,11 @@ void Output::snapshot(const Solver& solver) {
 void Output::history(const Solver& solver, const StepInfo& step) {
   const Energies e = solver.energies();
   if (!initial_total_) initial_total_ = e.total();
-  history_ << fmt::format("{},{:.17g},{:.17g},{},{},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.6g}\n",
-                          solver.steps(), solver.time(), step.dt, solver.particles().size(),
-                          solver.removed_particles(), e.kinetic, e.strain, e.gravity, e.plastic, e.damage, e.damping,
-                          e.walls,
-                          e.external, e.total() - *initial_total_);
+  history_ << fmt::format(
+      "{},{:.17g},{:.17g},{},{},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.6g}\n",
+      solver.steps(), solver.time(), step.dt, solver.particles().size(), solver.removed_particles(), e.kinetic,
+      e.strain, e.gravity, e.plastic, e.damage, e.damping, e.walls, e.transfer, e.left, e.external,
+      e.total() - *initial_total_);
   history_.flush();
   if (tracers_.empty()) return;
   const auto& p = solver.particles();

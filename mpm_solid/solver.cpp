@@ -104,6 +104,15 @@ Solver::Solver(Grid<2> grid, std::vector<std::unique_ptr<Material>> materials,
   node_ij_.resize(n);
   for (int j = 0; j < grid_.nodes_along(1); ++j)
     for (int i = 0; i < grid_.nodes_along(0); ++i) node_ij_[grid_.index({i, j})] = {i, j};
+  counted_.assign(n, 1);
+  for (int side = 0; side < 4; ++side) {
+    const auto type = settings_.walls[side].type;
+    if (type != Wall::Type::fixed && type != Wall::Type::roller) continue;
+    const int axis = side / 2, g = Grid<2>::ghost;
+    const int wall_row = side % 2 == 0 ? g : g + grid_.cells[axis];
+    for (std::size_t i = 0; i < n; ++i)
+      if (side % 2 == 0 ? node_ij_[i][axis] < wall_row : node_ij_[i][axis] > wall_row) counted_[i] = 0;
+  }
 
   double total_mass = 0;
   for (double m : particles_.mass) total_mass += m;
@@ -176,18 +185,23 @@ void Solver::rebuild_material_groups() {
   for (std::size_t p = 0; p < particles_.size(); ++p) members_[particles_.material[p]].push_back(static_cast<int>(p));
 }
 
-double Solver::stable_time_step() const {
+double stable_time_step(const std::vector<std::unique_ptr<Material>>& materials, const Particles<2>& particles,
+                        double h, double courant) {
   double fastest = 0;
-  const int n = static_cast<int>(particles_.size());
+  const int n = static_cast<int>(particles.size());
 #pragma omp parallel for schedule(static) reduction(max : fastest)
   for (int p = 0; p < n; ++p) {
-    const auto& e = materials_[particles_.material[p]]->elasticity();
+    const auto& e = materials[particles.material[p]]->elasticity();
     // The wave speed grows as the material compresses (density rises).
-    const double density = particles_.mass[p] / particles_.volume[p];
+    const double density = particles.mass[p] / particles.volume[p];
     const double c = std::sqrt((e.lame_lambda() + 2 * e.shear_modulus()) / density);
-    fastest = std::max(fastest, c + particles_.v[p].norm());
+    fastest = std::max(fastest, c + particles.v[p].norm());
   }
-  return settings_.courant * grid_.h / fastest;
+  return courant * h / fastest;
+}
+
+double Solver::stable_time_step() const {
+  return mpm::stable_time_step(materials_, particles_, grid_.h, settings_.courant);
 }
 
 template <class Shape, bool Apic>
@@ -371,16 +385,17 @@ void Solver::grid_update(double dt) {
     velocity_new_[i] =
         mass_[i] > empty_node_mass_ ? Vec<2>(shrink * (velocity_[i] + dt * force_[i] / mass_[i])) : Vec<2>::Zero();
   apply_platens(velocity_new_, shrink * dt, dt);  // before the walls: the ghost nodes mirror the plate's motion
+  dissipated_.walls += apply_walls(velocity_new_);
   if (c > 0) {
     // The damping force -c m v_new works along the way the nodes carry the
-    // particles, v_new dt, as the external forces are booked.
+    // particles, v_new dt (after the walls: what a wall stops does not move),
+    // as the external forces are booked.
     double viscous_work = 0;
 #pragma omp parallel for schedule(static) reduction(+ : viscous_work)
     for (std::size_t i = 0; i < n; ++i)
-      viscous_work += c * dt * mass_[i] * velocity_new_[i].squaredNorm();
+      if (counted_[i]) viscous_work += c * dt * mass_[i] * velocity_new_[i].squaredNorm();
     dissipated_.damping += viscous_work;
   }
-  dissipated_.walls += apply_walls(velocity_new_);
 }
 
 // What particles scatter to ghost nodes beyond a fixed or roller wall belongs,
@@ -464,7 +479,8 @@ void Solver::gather_motion(double dt) {
   const int n = static_cast<int>(p.size());
   const double flip = settings_.flip_fraction;
   Census census;
-#pragma omp parallel reduction(merge : census)
+  double lost = 0;
+#pragma omp parallel reduction(merge : census) reduction(+ : lost)
   {
     Stencil2<Shape> s;
 #pragma omp for schedule(static)
@@ -476,13 +492,16 @@ void Solver::gather_motion(double dt) {
       for (int k = 0; k < s.count; ++k) {
         const auto node = s.node[k];
         v_pic += s.weight[k] * velocity_new_[node];
+        dv += s.weight[k] * (velocity_new_[node] - velocity_[node]);
         if constexpr (Apic) {
           b += s.weight[k] * velocity_new_[node] * s.offset[k].transpose();
           d += s.weight[k] * s.offset[k].cwiseProduct(s.offset[k]);
-        } else {
-          dv += s.weight[k] * (velocity_new_[node] - velocity_[node]);
         }
       }
+      // Pure FLIP hands each particle the grid's change and keeps what the
+      // grid cannot hold (sub-cell velocity differences); the PIC share, and
+      // APIC, replace that with the grid's field: the energy they take.
+      const Vec<2> v_flip = p.v[i] + dv;
       if constexpr (!Move) displacement_[i] = dt * v_pic;
       if constexpr (Apic) {
         // D is diagonal for tensor-product shapes that reproduce linear fields;
@@ -491,8 +510,9 @@ void Solver::gather_motion(double dt) {
         for (int c = 0; c < 2; ++c)
           p.affine[i].col(c) = d[c] > 1e-12 * grid_.h * grid_.h ? Vec<2>(b.col(c) / d[c]) : Vec<2>::Zero();
       } else {
-        p.v[i] = flip * (p.v[i] + dv) + (1 - flip) * v_pic;
+        p.v[i] = flip * v_flip + (1 - flip) * v_pic;
       }
+      lost += 0.5 * p.mass[i] * (v_flip.squaredNorm() - p.v[i].squaredNorm());
       if constexpr (Move) {
         const Vec<2> moved = dt * v_pic;
         p.x[i] += moved;
@@ -501,6 +521,7 @@ void Solver::gather_motion(double dt) {
     }
   }
   if constexpr (Move) census_ = census;
+  dissipated_.transfer += lost;
 }
 
 // Every transfer of a step uses the particles' positions at its start; they move
@@ -593,6 +614,16 @@ void Solver::remove_escaped(const Census& census, StepInfo& info) {
   if (escaped == n) throw SimulationError(fmt::format("mpm: step {}: every particle has left the grid", steps_ + 1));
   std::vector<char> keep(p.size());
   for (int i = 0; i < n; ++i) keep[i] = grid_.inside(p.x[i]);
+  // The energy they carry off leaves the books with them.
+  std::vector<std::vector<int>> leaving(materials_.size());
+  for (int i = 0; i < n; ++i)
+    if (!keep[i]) {
+      leaving[p.material[i]].push_back(i);
+      dissipated_.left +=
+          0.5 * p.mass[i] * p.v[i].squaredNorm() - p.mass[i] * settings_.gravity.dot(p.x[i] - grid_.lower);
+    }
+  for (std::size_t m = 0; m < materials_.size(); ++m)
+    if (!leaving[m].empty()) dissipated_.left += materials_[m]->strain_energy(p, leaving[m]);
   p.keep(keep);
   info.removed = static_cast<std::size_t>(escaped);
   removed_ += info.removed;

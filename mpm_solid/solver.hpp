@@ -106,16 +106,25 @@ class SimulationError : public std::runtime_error {
 // Energies per metre of depth [J/m]. Stored ones are computed from the current
 // state; dissipated and external ones accumulate over the run. With the
 // gravitational potential measured from the grid's lower edge,
-//   kinetic + strain + gravity + plastic + damage + damping + walls - external
-// stays constant but for what the method itself dissipates: the balance error.
-// That holds the grid's velocity projections, including the kinetic energy a
-// wall removes from material moving into it (an inelastic impact, or O(dt)
-// per unit time for material resting on it); `walls` counts friction only.
+//   kinetic + strain + gravity + plastic + damage + damping + walls + transfer
+//   + left - external
+// stays constant but for the time integration's own error: the balance error.
+// `transfer` is the kinetic energy the grid-to-particle transfer takes beyond
+// what pure FLIP would leave (the PIC share of the blend, or APIC: they
+// replace the particles' sub-cell velocity differences with the grid's field,
+// which damps separating fragments); `walls` the work of wall friction;
+// `left` what particles carried off the grid. What remains in the balance is
+// the explicit scheme's own error, and the energy of material striking a wall
+// (an inelastic impact on the grid).
 struct Energies {
   double kinetic = 0, strain = 0, gravity = 0;
-  double plastic = 0, damage = 0, damping = 0, walls = 0;  // dissipated so far (walls: friction)
+  double plastic = 0, damage = 0, damping = 0, walls = 0;  // dissipated so far
+  double transfer = 0;                                     // lost in particle-grid transfers so far
+  double left = 0;                                         // carried off by particles that left the grid
   double external = 0;                                     // work of the external forces so far
-  double total() const { return kinetic + strain + gravity + plastic + damage + damping + walls - external; }
+  double total() const {
+    return kinetic + strain + gravity + plastic + damage + damping + walls + transfer + left - external;
+  }
 };
 
 struct StepInfo {
@@ -137,12 +146,17 @@ struct Census {
   }
 };
 
+// Largest stable step: courant h / max over particles of (c_p + |v_p|), c_p
+// the P-wave speed of each particle's material at its current density.
+double stable_time_step(const std::vector<std::unique_ptr<Material>>& materials, const Particles<2>& particles,
+                        double h, double courant);
+
 class Solver {
  public:
   Solver(Grid<2> grid, std::vector<std::unique_ptr<Material>> materials, Particles<2> particles,
          Settings settings);
 
-  // Largest stable step: courant * h / max over particles of (c_p + |v_p|).
+  // The free function's step for this solver's particles and grid.
   double stable_time_step() const;
   // One explicit step; SimulationError (naming the step, particle and field)
   // if a particle's state becomes non-finite or it outruns its P wave.
@@ -235,6 +249,9 @@ class Solver {
   std::vector<std::vector<double>> thread_mass_;     // of threads 1, 2, ...
   std::vector<std::vector<Vec<2>>> thread_vector_;
   std::vector<std::array<int, 2>> node_ij_;  // grid coordinates of each node
+  // Nodes whose mass counts once (in the damping's work): not the ghosts
+  // beyond a fixed or roller wall, whose share fold_ghosts moved inside.
+  std::vector<char> counted_;
   std::vector<Vec<2>> displacement_;         // of each particle over the step
   struct ObstacleNode {
     std::size_t node;
