@@ -72,6 +72,7 @@ int run(const RunOptions& options, scene::Document& doc) {
     if (at_rest) break;
   }
   progress.finish();
+  out.finish();
   if (at_rest)
     spdlog::info("at rest at t = {:.4g} s: kinetic energy {:.3g} J/m, below {:g} of its peak {:.3g} J/m",
                  solver.time(), solver.kinetic_energy(), *header.rest_fraction, rest.peak());

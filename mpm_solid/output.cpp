@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
 namespace outburst::mpm {
 
@@ -29,7 +30,11 @@ Output::Output(const std::filesystem::path& directory, const output::RunInfo& in
 }
 
 void Output::snapshot(const Solver& solver) {
-  if (!initial_total_) initial_total_ = solver.energies().total();
+  if (!initial_total_) {
+    const Energies e = solver.energies();
+    initial_total_ = e.total();
+    audit_.record(e, solver.time());
+  }
   const auto& p = solver.particles();
   const std::size_t n = p.size();
   std::vector<double> xyz, velocity, displacement, stress, s_max, s_min, material, id, damage, plastic;
@@ -66,6 +71,7 @@ void Output::snapshot(const Solver& solver) {
 void Output::history(const Solver& solver, const StepInfo& step) {
   const Energies e = solver.energies();
   if (!initial_total_) initial_total_ = e.total();
+  audit_.record(e, solver.time());
   history_ << fmt::format(
       "{},{:.17g},{:.17g},{},{},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.6g}\n",
       solver.steps(), solver.time(), step.dt, solver.particles().size(), solver.removed_particles(), e.kinetic,
@@ -86,6 +92,17 @@ void Output::history(const Solver& solver, const StepInfo& step) {
                                 p.damage.empty() ? 0.0 : p.damage[i]);
   }
   tracer_file_.flush();
+}
+
+void Output::finish() const {
+  const double open = audit_.open_share();
+  if (open > 0.01)
+    spdlog::warn("the energy budget is open by {:.2g} % of its largest term ({:.3g} J/m) at t = {:.4g} s: the "
+                 "time step may be too close to the stable one, or the run went unstable (mpm_history.csv)",
+                 100 * open, audit_.largest_term(), audit_.worst_time());
+  else
+    spdlog::info("energy budget closed to {:.2g} % of its largest term ({:.3g} J/m)", 100 * open,
+                 audit_.largest_term());
 }
 
 }  // namespace outburst::mpm

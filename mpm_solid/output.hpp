@@ -23,11 +23,17 @@ class Output {
   void snapshot(const Solver& solver);
   void history(const Solver& solver, const StepInfo& step);
   const output::FieldSeries& series() const { return series_; }
+  // The energy books of the histories written so far; at the end of a run,
+  // finish() warns in the log if they are open by more than 1 % of their
+  // largest term (the method lost or, worse, created energy).
+  const EnergyAudit& energy_audit() const { return audit_; }
+  void finish() const;
 
  private:
   output::FieldSeries series_;
   std::ofstream history_;
   std::optional<double> initial_total_;  // energy total when the history starts
+  EnergyAudit audit_;
   std::vector<int> tracers_;
   std::ofstream tracer_file_;
 };

@@ -479,8 +479,9 @@ void Solver::gather_motion(double dt) {
   const int n = static_cast<int>(p.size());
   const double flip = settings_.flip_fraction;
   Census census;
-  double lost = 0;
-#pragma omp parallel reduction(merge : census) reduction(+ : lost)
+  double lost = 0, work = 0;
+  const bool loads = !lean_build && !p.external_force.empty();
+#pragma omp parallel reduction(merge : census) reduction(+ : lost, work)
   {
     Stencil2<Shape> s;
 #pragma omp for schedule(static)
@@ -513,15 +514,20 @@ void Solver::gather_motion(double dt) {
         p.v[i] = flip * v_flip + (1 - flip) * v_pic;
       }
       lost += 0.5 * p.mass[i] * (v_flip.squaredNorm() - p.v[i].squaredNorm());
+      // The external force works along the way the particle went, at the
+      // grid's velocity halfway through the step (the grid's kinetic energy
+      // changes by f (v + v_new) dt / 2), not its own FLIP-blended one.
+      if (loads) work += (p.external_force[i] + p.surface_force[i]).dot(dt * (v_pic - 0.5 * dv));
       if constexpr (Move) {
         const Vec<2> moved = dt * v_pic;
         p.x[i] += moved;
-        count(i, moved, dt, census);
+        count(i, dt, census);
       }
     }
   }
   if constexpr (Move) census_ = census;
   dissipated_.transfer += lost;
+  dissipated_.external += work;
 }
 
 // Every transfer of a step uses the particles' positions at its start; they move
@@ -554,14 +560,10 @@ void Solver::step_kernel(double dt) {
   }
 }
 
-// Books a moved particle: the work of its external force (with the new
-// velocity), and whether it went wrong or left.
-void Solver::count(int i, const Vec<2>& moved, double dt, Census& census) const {
+// Books a moved particle: the work of a pore pressure on it, and whether it
+// went wrong or left.
+void Solver::count(int i, double dt, Census& census) const {
   const auto& p = particles_;
-  // Along the way the particle went (the grid's velocity), not its own
-  // (FLIP-blended) velocity, which may differ from it.
-  if (!lean_build && !p.external_force.empty())
-    census.external_work += (p.external_force[i] + p.surface_force[i]).dot(moved);
   // A pore pressure does work on the skeleton as it dilates.
   if (!lean_build && !p.pore_pressure.empty())
     census.external_work += p.pore_pressure[i] * p.volume[i] * p.velocity_gradient[i].trace() * dt;
@@ -580,7 +582,7 @@ Census Solver::move_particles(double dt) {
 #pragma omp parallel for schedule(static) reduction(merge : census)
   for (int i = 0; i < n; ++i) {
     p.x[i] += displacement_[i];
-    count(i, displacement_[i], dt, census);
+    count(i, dt, census);
   }
   return census;
 }
@@ -725,5 +727,17 @@ Energies Solver::energies() const {
   return e;
 }
 
+
+void EnergyAudit::record(const Energies& e, double time) {
+  if (!first_) first_ = e;
+  const Energies& f = *first_;
+  for (double term : {e.kinetic - f.kinetic, e.strain - f.strain, e.gravity - f.gravity, e.plastic, e.damage,
+                      e.damping, e.walls, e.transfer, e.left, e.external})
+    largest_term_ = std::max(largest_term_, std::abs(term));
+  if (const double error = std::abs(e.total() - f.total()); error > worst_error_) {
+    worst_error_ = error;
+    worst_time_ = time;
+  }
+}
 
 }  // namespace outburst::mpm

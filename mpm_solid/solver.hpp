@@ -127,6 +127,22 @@ struct Energies {
   }
 };
 
+// Whether a run's energy books close: over the states recorded, the largest
+// balance error against the largest change of any term (the stored energies'
+// changes from the first state, the dissipated and external ones' totals).
+class EnergyAudit {
+ public:
+  void record(const Energies& e, double time);
+  // Largest |balance error| over the largest term; 0 before two records.
+  double open_share() const { return largest_term_ > 0 ? worst_error_ / largest_term_ : 0.0; }
+  double largest_term() const { return largest_term_; }
+  double worst_time() const { return worst_time_; }
+
+ private:
+  std::optional<Energies> first_;
+  double largest_term_ = 0, worst_error_ = 0, worst_time_ = 0;
+};
+
 struct StepInfo {
   double dt;
   std::size_t removed = 0;  // particles that left the grid this step
@@ -227,7 +243,7 @@ class Solver {
   void find_obstacle_nodes();
   void fold_ghosts(std::vector<double>* mass, std::vector<Vec<2>>& vectors) const;
   void update_stresses(double dt);
-  void count(int i, const Vec<2>& moved, double dt, Census& census) const;
+  void count(int i, double dt, Census& census) const;
   Census move_particles(double dt);
   void remove_escaped(const Census& census, StepInfo& info);
   void rebuild_material_groups();
