@@ -110,6 +110,9 @@ int run_program(const std::string& program, const std::string& description, int 
   try {
     auto doc = scene::Document::load(options.scene, options.overrides);
     return run(options, *doc);
+  } catch (const scene::Refusal& e) {
+    spdlog::error("{}", e.what());
+    return 4;
   } catch (const scene::Error& e) {
     spdlog::error("{}", e.what());
     return 2;

@@ -5,7 +5,9 @@
 //             [--quiet] [--log-level LEVEL] [--threads N]
 //
 // and the one place that turns exceptions into exit codes: 2 for a bad scene or
-// command line (with the file, line and key), 1 for a run that failed.
+// command line (with the file, line and key), 4 for a valid scene refused
+// because what it asks for cannot work in its regime (scene::Refusal: a
+// coupling scheme predicted unstable), 1 for a run that failed.
 
 #include <algorithm>
 #include <filesystem>

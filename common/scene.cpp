@@ -237,6 +237,11 @@ void Table::fail(std::string_view key, const std::string& message) const {
   throw Error(doc_->located(n ? n : table_, key_path(key), message));
 }
 
+void Table::refuse(std::string_view key, const std::string& message) const {
+  const toml::node* n = table_->get(key);
+  throw Refusal(doc_->located(n ? n : table_, key_path(key), message));
+}
+
 const toml::node* Table::required_node(const Key& key) const {
   const toml::node* n = node(key.name);
   if (!n && key.fallback.empty())

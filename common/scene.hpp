@@ -36,6 +36,15 @@ class Error : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// A well-formed scene that asks for what cannot work in its regime (a
+// coupling scheme its stability analysis predicts unstable): refused before
+// the first step with its own exit code, so that a sweep can tell a refused
+// setting from a mistake.
+class Refusal : public Error {
+ public:
+  using Error::Error;
+};
+
 // A numeric range, checked after conversion to SI.
 struct Range {
   std::optional<double> min, max;
@@ -109,6 +118,8 @@ class Table {
 
   // An error located at this key (or at the table when the key is absent).
   [[noreturn]] void fail(std::string_view key, const std::string& message) const;
+  // As fail(), for a value that is valid but cannot work here (scene::Refusal).
+  [[noreturn]] void refuse(std::string_view key, const std::string& message) const;
 
  private:
   const toml::node* node(std::string_view key) const;

@@ -91,23 +91,15 @@ void SeepageParticipant::apply_solid_state() {
 
 void SeepageParticipant::advance(double window) {
   apply_solid_state();
-  const Eigen::VectorXd start = read("pressure");
   if (settings_.biot_storage) {
-    // Rates over the solid's last window, which matched the seepage's last.
-    const auto& mesh = solver_.mesh();
+    // The rate over the solid's last window, which matched the seepage's last.
     std::vector<double> source(static_cast<std::size_t>(dilatation_.size()), 0.0);
     if (last_size_ > 0)
-      for (std::size_t c = 0; c < source.size(); ++c) {
-        double pressure_rate = 0;
-        for (int node : mesh.cells[c]) pressure_rate += 0.25 * (last_end_[node] - last_start_[node]) / last_size_;
-        source[c] = -settings_.biot * dilatation_[static_cast<Eigen::Index>(c)] / last_size_ +
-                    settings_.fixed_stress * pressure_rate;
-      }
+      for (std::size_t c = 0; c < source.size(); ++c)
+        source[c] = -settings_.biot * dilatation_[static_cast<Eigen::Index>(c)] / last_size_;
     solver_.set_cell_source(std::move(source));
   }
   last_report_ = solver_.advance(window);
-  last_start_ = start;
-  last_end_ = read("pressure");
   last_size_ = window;
 }
 
@@ -122,9 +114,12 @@ SolidParticipant::SolidParticipant(mpm::Solver& solver, const MeshMapping& mappi
       mapping_(mapping),
       biot_(settings.biot),
       force_(settings.force),
+      fixed_stress_(settings.fixed_stress),
+      window_pressure_(settings.window_pressure),
       fixed_time_step_(fixed_time_step),
       pressure_start_(pressure),
       pressure_end_(std::move(pressure)),
+      felt_change_(Eigen::VectorXd::Zero(pressure_start_.size())),
       sends_dilatation_(settings.biot_storage) {
   if (pressure_start_.size() != static_cast<Eigen::Index>(mapping_.mesh().num_nodes()))
     throw std::invalid_argument("solid: the initial pressure does not match the seepage mesh");
@@ -163,14 +158,20 @@ void SolidParticipant::compute_averages() const {
   const auto& p = solver_.particles();
   const std::size_t k = sends_dilatation_ ? 5 : 4;
   std::vector<double> values(k * p.size());
+  // Fixed stress: the volume change less (alpha / K_dr) times the change of
+  // the pressure felt, beta / alpha = alpha / K_dr.
+  const double felt_share = fixed_stress_ > 0 ? fixed_stress_ / biot_ : 0.0;
   for (std::size_t i = 0; i < p.size(); ++i) {
     values[k * i] = p.stress[i](0, 0);
     values[k * i + 1] = p.stress[i](1, 1);
     values[k * i + 2] = p.stress[i](0, 1);
     values[k * i + 3] = p.damage.empty() ? 0.0 : p.damage[i];
     // Volume-weighted, this sums to the volume change over the window.
-    if (sends_dilatation_)
+    if (sends_dilatation_) {
       values[k * i + 4] = (p.volume[i] - start_volume_[static_cast<std::size_t>(p.id[i])]) / p.volume[i];
+      if (felt_share > 0)
+        if (const auto felt = mapping_.sample(felt_change_, p.x[i])) values[k * i + 4] -= felt_share * felt->value;
+    }
   }
   averages_ = mapping_.average(p.x, p.volume, values, static_cast<int>(k));
 }
@@ -192,9 +193,10 @@ Eigen::VectorXd SolidParticipant::read(const std::string& field) const {
 }
 
 // The gas force (-alpha grad(p) V_p, or alpha p in the total stress) with p
-// interpolated between the window's ends at `fraction` of it.
+// interpolated between the window's ends at `fraction` of it, or at its end.
 void SolidParticipant::set_gas_force(double fraction) {
   const auto& p = solver_.particles();
+  if (window_pressure_ == stability::Pressure::end) fraction = 1;
   pressure_now_ = (1 - fraction) * pressure_start_ + fraction * pressure_end_;
   const int n = static_cast<int>(p.size());
   // Particles leaving the grid renumber the rest: the hints are then only stale.
@@ -229,6 +231,7 @@ void SolidParticipant::advance(double window) {
     last_window_.dt = info.dt;
     last_window_.removed += info.removed;
   }
+  felt_change_ = pressure_end_ - pressure_start_;
   pressure_start_ = pressure_end_;
   averages_.reset();
 }

@@ -17,13 +17,18 @@
 //     "stress" (volume-averaged effective stress xx, yy, xy [Pa]) and "damage";
 //     with Biot storage also "dilatation": the particles' volume change over
 //     the window per cell area, which the seepage takes as the source
-//     -alpha dilatation / window (linear Darcy law).
+//     -alpha dilatation / window (linear Darcy law). With the fixed-stress
+//     split the solid sends the volume change less (alpha / K_dr) times the
+//     change of the pressure it felt, so that the seepage's extra storage
+//     alpha^2 / K_dr cancels at convergence and what it takes depends only
+//     on what the coupling hands it (an accelerated iteration needs that).
 
 #include <optional>
 #include <vector>
 
 #include "coupler/coupling.hpp"
 #include "coupler/mapping.hpp"
+#include "coupler/stability.hpp"
 #include "mpm_solid/solver.hpp"
 #include "seepage_fe/solver.hpp"
 
@@ -62,10 +67,13 @@ struct GasSolidSettings {
   bool biot_storage = false;   // the solid's volume change is a seepage source
   // Fixed-stress split (Kim, Tchelepi & Juanes 2011): the seepage carries the
   // extra storage beta = alpha^2 / K_dr and the source beta dp/dt of the
-  // pressure it last computed, so the staggered scheme is stable and its
+  // pressure the solid felt, so the staggered scheme is stable and its
   // iteration a contraction; the two cancel once the window has converged.
   // [1/Pa]; 0: off.
   double fixed_stress = 0;
+  // The pore pressure the solid feels within a window: the ramp between its
+  // ends, or its end value throughout (coupler/stability.hpp).
+  stability::Pressure window_pressure = stability::Pressure::ramp;
 };
 
 class SeepageParticipant final : public Participant {
@@ -89,10 +97,9 @@ class SeepageParticipant final : public Participant {
   GasSolidSettings settings_;
   std::vector<double> lambda0_;  // the scene's conductivity per cell
   Eigen::VectorXd occupancy_, stress_, damage_, dilatation_;
-  // The pressure the last advance started from and ended at, and its size:
-  // the "old" rates the Biot source uses (the previous iterate of this window,
+  // The size of the last advance: the solid's dilatation covers the window
+  // it last took, which had this size (the previous iterate of this window,
   // or the previous window in a one-pass scheme).
-  Eigen::VectorXd last_start_, last_end_;
   double last_size_ = 0;
   seepage::Solver::State saved_;
   seepage::StepReport last_report_;
@@ -102,8 +109,9 @@ class SeepageParticipant final : public Participant {
 class SolidParticipant final : public Participant {
  public:
   // `pressure` is the nodal p [Pa] at the start (the seepage's initial state).
-  // Of `settings` it uses alpha, the gas force's form, and Biot storage
-  // ("dilatation" is tracked and sent only with it).
+  // Of `settings` it uses alpha, the gas force's form, Biot storage
+  // ("dilatation" is tracked and sent only with it), the fixed-stress split
+  // and the window pressure.
   SolidParticipant(mpm::Solver& solver, const MeshMapping& mapping, const GasSolidSettings& settings,
                    Eigen::VectorXd pressure, std::optional<double> fixed_time_step);
   std::string name() const override { return "solid"; }
@@ -131,8 +139,11 @@ class SolidParticipant final : public Participant {
   const MeshMapping& mapping_;
   double biot_;
   GasForce force_;
+  double fixed_stress_;  // beta [1/Pa]
+  stability::Pressure window_pressure_;
   std::optional<double> fixed_time_step_;
   Eigen::VectorXd pressure_start_, pressure_end_, pressure_now_;
+  Eigen::VectorXd felt_change_;  // the pressure felt at the last window's end less at its start
   std::vector<int> cell_hint_;  // per particle, the seepage cell it was last found in
   bool sends_dilatation_;
   std::vector<double> start_volume_;  // per particle id, at the window's start

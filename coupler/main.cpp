@@ -94,6 +94,7 @@ int run(const RunOptions& options, scene::Document& doc) {
     if (at_rest) break;
   }
   progress.finish();
+  solid_out.finish();
   if (at_rest)
     spdlog::info("the coal is at rest at t = {:.4g} s: kinetic energy {:.3g} J/m, below {:g} of its peak {:.3g} J/m",
                  coupler.time(), solid.kinetic_energy(), *header.rest_fraction, rest.peak());

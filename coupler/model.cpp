@@ -3,12 +3,122 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
 namespace outburst::coupling {
 
-CoupledSetup read_coupled_setup(scene::Table root) {
+namespace {
+
+double narrowest_cell(const seepage::Mesh& mesh) {
+  double narrowest = std::numeric_limits<double>::infinity();
+  for (std::size_t c = 0; c < mesh.num_cells(); ++c) {
+    const auto x = mesh.corners(c);
+    for (int k = 0; k < 4; ++k) narrowest = std::min(narrowest, (x[(k + 1) % 4] - x[k]).norm());
+  }
+  return narrowest;
+}
+
+}  // namespace
+
+std::vector<stability::Regime> poroelastic_regimes(const CoupledSetup& s) {
+  const double cell = narrowest_cell(s.seepage.mesh);
+  const auto& nodes = s.seepage.mesh.nodes;
+  Eigen::Vector2d lo = nodes.front(), hi = nodes.front();
+  for (const auto& x : nodes) {
+    lo = lo.cwiseMin(x);
+    hi = hi.cwiseMax(x);
+  }
+  std::vector<stability::Regime> regimes;
+  for (const auto& material : s.solid.materials)
+    for (const auto& region : s.seepage.model.materials) {
+      const auto& e = material->elasticity();
+      regimes.push_back({e.density, e.lame_lambda() + 2 * e.shear_modulus(),
+                         e.lame_lambda() + 2.0 / 3.0 * e.shear_modulus(), s.solid.settings.viscous_damping,
+                         s.coupling.gas_solid.biot, region.capacity, region.conductivity, (hi - lo).maxCoeff(),
+                         cell});
+    }
+  return regimes;
+}
+
+namespace {
+
+// The worst predicted growth over the regimes, and the regime it is in.
+struct Prediction {
+  stability::Growth growth;
+  const stability::Regime* regime;
+};
+Prediction predict(const std::vector<stability::Regime>& regimes, const stability::Window& window) {
+  Prediction worst{{-std::numeric_limits<double>::infinity(), 0}, nullptr};
+  for (const auto& r : regimes)
+    if (const auto g = stability::growth(r, window); g.rate > worst.growth.rate) worst = {g, &r};
+  return worst;
+}
+
+std::string describe(const stability::Window& w) {
+  return fmt::format("{} coupling{} with the solid feeling the pore pressure's {}",
+                     w.iterated ? "the implicit" : "the explicit", w.fixed_stress ? " (fixed-stress split)" : "",
+                     w.pressure == stability::Pressure::ramp ? "ramp over the window" : "end value");
+}
+
+// With Biot storage: resolves window_pressure "auto" to the ramp where the
+// analysis predicts the scheme stable, else to the end value (iterated, with
+// the fixed-stress split unless the scene sets it); refuses a scheme the scene
+// names that cannot be stable at its window, naming the limit and the stable
+// alternative.
+void choose_window_pressure(const scene::Table& root, CoupledSetup& s) {
+  auto& cs = s.coupling;
+  const auto coupling = root.table("coupling", "", true);
+  using Kind = SchemeSettings::Kind;
+  if (cs.scheme.kind == Kind::one_way) return;  // nothing comes back to the seepage
+  const auto regimes = poroelastic_regimes(s);
+  stability::Window w{cs.scheme.kind == Kind::implicit, cs.fixed_stress_split.value_or(false),
+                      cs.window_pressure.value_or(stability::Pressure::ramp), cs.window};
+  const Prediction p = predict(regimes, w);
+  if (p.growth.rate <= 0) {
+    cs.window_pressure = w.pressure;
+    spdlog::debug("coupling: {} at a window of {:.3g} s is predicted stable (slowest decay {:.3g} 1/s)", describe(w),
+                  cs.window, -p.growth.rate);
+    return;
+  }
+  const double limit = stability::smallest_stable_window(*p.regime, w, cs.window, 1e4 * cs.window);
+  const std::string why = fmt::format(
+      "{} grows by {:.3g} 1/s at a window of {:.3g} s (the mode of wavelength {:.3g} m; coupler/stability.hpp); {}",
+      describe(w), p.growth.rate, cs.window, 2 * std::numbers::pi / p.growth.wavenumber,
+      limit > 0 ? fmt::format("it is stable from a window of about {:.3g} s", limit)
+                : std::string("no window up to 1e4 times this one is stable"));
+  const std::string stable = "scheme = \"implicit\" with window_pressure = \"end\" is stable for any window";
+  if (cs.window_pressure || !w.iterated) {
+    const std::string_view key = cs.window_pressure ? "window_pressure" : "scheme";
+    if (!cs.allow_unstable)
+      coupling->refuse(key, fmt::format("{}; {} (or take a larger coupling.window)", why, stable));
+    cs.window_pressure = w.pressure;
+    spdlog::warn("coupling: {}; run anyway (allow_unstable = true)", why);
+    return;
+  }
+  cs.window_pressure = stability::Pressure::end;
+  if (!cs.fixed_stress_split) cs.fixed_stress_split = true;
+  spdlog::info("coupling: {}; the solid feels the window's end pressure instead (window_pressure = \"auto\"){}",
+               why, *cs.fixed_stress_split ? ", with the fixed-stress split" : "");
+}
+
+// A fixed mpm.time_step against the particles' stable step, as mpm-solid
+// checks it (before --check returns).
+void check_time_step(const scene::Table& root, const CoupledSetup& s) {
+  if (!s.solid.fixed_time_step) return;
+  const double limit = mpm::stable_time_step(s.solid.materials, s.solid.particles, s.solid.grid.h, 1.0);
+  if (*s.solid.fixed_time_step > limit)
+    root.table("mpm", "", true)->fail(
+        "time_step", fmt::format("{:.3g} s exceeds the stability limit h / (c + |v|) = {:.3g} s of this scene; use "
+                                 "a smaller step or drop the key to let the CFL condition choose",
+                                 *s.solid.fixed_time_step, limit));
+}
+
+}  // namespace
+
+CoupledSetup read_coupled_scene(scene::Table root) {
   CoupledSetup s;
   s.header = read_scene_header(root);
   require_solvers(root, s.header, {"seepage", "mpm"}, "outburst");
@@ -28,12 +138,9 @@ CoupledSetup read_coupled_setup(scene::Table root) {
   // pressure grows without bound with particles 0.0625 m apart on 0.05 m
   // cells; the outburst's seam opened whole with particles 1/6 m apart on
   // 0.25 m cells, one to a row in some: 44 % full).
-  double spacing = 0, narrowest = std::numeric_limits<double>::infinity();
+  double spacing = 0;
   for (double w : s.solid.particles.half_width) spacing = std::max(spacing, 2 * w * s.solid.grid.h);
-  for (std::size_t c = 0; c < s.seepage.mesh.num_cells(); ++c) {
-    const auto x = s.seepage.mesh.corners(c);
-    for (int k = 0; k < 4; ++k) narrowest = std::min(narrowest, (x[(k + 1) % 4] - x[k]).norm());
-  }
+  const double narrowest = narrowest_cell(s.seepage.mesh);
   const double per_row = std::floor(narrowest / spacing * (1 + 1e-9));
   const double least_fill = std::pow(per_row * spacing / narrowest, 2);
   if (per_row < 1 || least_fill < s.coupling.gas_solid.open_below)
@@ -43,6 +150,13 @@ CoupledSetup read_coupled_setup(scene::Table root) {
                     "below coupling.open_below = {:g} read as open space and miss the coal's volume change): "
                     "refine the MPM (grid.cell_size, bodies' particles_per_cell) or coarsen the seepage mesh",
                     spacing, narrowest, 100 * least_fill, s.coupling.gas_solid.open_below));
+  check_time_step(root, s);
+  return s;
+}
+
+CoupledSetup read_coupled_setup(scene::Table root) {
+  CoupledSetup s = read_coupled_scene(root);
+  if (s.coupling.gas_solid.biot_storage) choose_window_pressure(root, s);
   return s;
 }
 
@@ -55,7 +169,7 @@ CoupledModel::CoupledModel(CoupledSetup setup) : setup_(std::move(setup)) {
                                          solid.settings);
   mapping_ = std::make_unique<MeshMapping>(seep.mesh);
   GasSolidSettings gas_solid = cs.gas_solid;
-  if (cs.fixed_stress_split) {
+  if (cs.fixed_stress_split.value_or(false)) {
     double bulk = std::numeric_limits<double>::infinity();
     for (const auto& m : solid_->materials()) {
       const auto& e = m->elasticity();
@@ -63,6 +177,7 @@ CoupledModel::CoupledModel(CoupledSetup setup) : setup_(std::move(setup)) {
     }
     gas_solid.fixed_stress = gas_solid.biot * gas_solid.biot / bulk;
   }
+  gas_solid.window_pressure = cs.window_pressure.value_or(stability::Pressure::ramp);
   seepage_side_ = std::make_unique<SeepageParticipant>(*seepage_, gas_solid);
   solid_side_ = std::make_unique<SolidParticipant>(*solid_, *mapping_, gas_solid, seepage_side_->read("pressure"),
                                                    solid.fixed_time_step);

@@ -26,8 +26,17 @@ struct CoupledSetup {
 };
 
 // Reads [scene], [seepage], [mpm] and [coupling] (the caller then rejects
-// unused keys).
+// unused keys), and with Biot storage resolves the window pressure by the
+// stability analysis, refusing (scene::Refusal) a scheme the scene names that
+// cannot be stable at its window.
 CoupledSetup read_coupled_setup(scene::Table root);
+// The same without that resolution: what the scene says, as it says it.
+CoupledSetup read_coupled_scene(scene::Table root);
+
+// The poroelastic regime of every pair of MPM material and seepage region,
+// with the modes the seepage mesh carries along its longest extent
+// (coupler/stability.hpp).
+std::vector<stability::Regime> poroelastic_regimes(const CoupledSetup& setup);
 
 class CoupledModel {
  public:

@@ -46,12 +46,33 @@ CouplingSetup read_coupling(const scene::Table& c) {
   g.biot_storage = c.boolean({"biot_storage", "the solid's volume change feeds the seepage: source -alpha "
                                               "d(eps_v)/dt (linear Darcy law only; for poroelastic checks)",
                               gas_default.biot_storage ? "true" : "false"});
-  s.fixed_stress_split = c.boolean({"fixed_stress", "with biot_storage: stabilise the split by the fixed-stress "
-                                                   "extra storage alpha^2 / K_dr (K_dr the smallest drained bulk "
-                                                   "modulus of the materials)",
-                                   "false"});
-  if (s.fixed_stress_split && !g.biot_storage)
+  const bool fixed_stress_named = c.has("fixed_stress");
+  const bool fixed_stress = c.boolean({"fixed_stress", "with biot_storage: stabilise the split by the fixed-stress "
+                                                      "extra storage alpha^2 / K_dr (K_dr the smallest drained bulk "
+                                                      "modulus of the materials); unset, window_pressure \"auto\" "
+                                                      "turns it on where it picks \"end\"",
+                                       "false"});
+  if (fixed_stress && !g.biot_storage)
     c.fail("fixed_stress", "stabilises the Biot storage coupling: set biot_storage = true or drop the key");
+  if (fixed_stress_named) s.fixed_stress_split = fixed_stress;
+  const std::string pressure = c.choice(
+      {"window_pressure", "with biot_storage, the pore pressure the solid feels within a window: \"ramp\" (linear "
+                          "between the window's ends), \"end\" (the window's end value throughout: backward Euler "
+                          "in the coupling, stable for any window and fluid once iterated) or \"auto\" (the ramp "
+                          "where coupler/stability.hpp predicts the scheme stable, else the end value, iterated, "
+                          "with the fixed-stress split unless fixed_stress is set)",
+       "auto"},
+      {"auto", "ramp", "end"});
+  s.allow_unstable = c.boolean({"allow_unstable", "with biot_storage: run a scheme coupler/stability.hpp predicts "
+                                                  "unstable (with a warning) instead of refusing it, to measure "
+                                                  "the prediction (cases/terzaghi/stability_map.py)",
+                                "false"});
+  if (pressure != "auto") {
+    if (!g.biot_storage)
+      c.fail("window_pressure", "chooses what the solid feels of the Biot storage coupling: set biot_storage = true "
+                                "or drop the key");
+    s.window_pressure = pressure == "ramp" ? stability::Pressure::ramp : stability::Pressure::end;
+  }
   const double dilatation_floor = c.number({"dilatation_floor", "absolute convergence of the dilatation field "
                                                                 "(volume change per cell area over a window)",
                                             "1e-12", Range::non_negative()});
