@@ -734,7 +734,8 @@ void EnergyAudit::record(const Energies& e, double time) {
   for (double term : {e.kinetic - f.kinetic, e.strain - f.strain, e.gravity - f.gravity, e.plastic, e.damage,
                       e.damping, e.walls, e.transfer, e.left, e.external})
     largest_term_ = std::max(largest_term_, std::abs(term));
-  if (const double error = std::abs(e.total() - f.total()); error > worst_error_) {
+  last_error_ = std::abs(e.total() - f.total());
+  if (const double error = last_error_; error > worst_error_) {
     worst_error_ = error;
     worst_time_ = time;
   }

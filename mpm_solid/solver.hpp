@@ -135,12 +135,14 @@ class EnergyAudit {
   void record(const Energies& e, double time);
   // Largest |balance error| over the largest term; 0 before two records.
   double open_share() const { return largest_term_ > 0 ? worst_error_ / largest_term_ : 0.0; }
+  // The balance error of the last state recorded over the largest term.
+  double final_share() const { return largest_term_ > 0 ? last_error_ / largest_term_ : 0.0; }
   double largest_term() const { return largest_term_; }
   double worst_time() const { return worst_time_; }
 
  private:
   std::optional<Energies> first_;
-  double largest_term_ = 0, worst_error_ = 0, worst_time_ = 0;
+  double largest_term_ = 0, worst_error_ = 0, worst_time_ = 0, last_error_ = 0;
 };
 
 struct StepInfo {

@@ -9,8 +9,10 @@
 #include <fmt/format.h>
 
 #include "coupler/model.hpp"
+#include "poroelastic_solutions.hpp"
 
 using namespace outburst;
+using namespace outburst::testing;
 
 namespace {
 
@@ -19,32 +21,6 @@ double mean_iterations(const coupling::CoupledModel& model) {
   for (const auto& w : model.coupling().records()) sum += w.iterations;
   return sum / static_cast<double>(model.coupling().records().size());
 }
-
-// Terzaghi: p(z, t) = sum 2 p0 / M_m sin(M_m z / H) exp(-M_m^2 T), z from the
-// drained top, M_m = pi (2m + 1) / 2, T = c_v t / H^2.
-struct Terzaghi {
-  double H, p0, cv;
-  double pressure(double z, double t) const {
-    double sum = 0;
-    for (int m = 0; m < 400; ++m) {
-      const double mm = 3.14159265358979323846 * (2 * m + 1) / 2;
-      sum += 2 * p0 / mm * std::sin(mm * z / H) * std::exp(-mm * mm * cv * t / (H * H));
-    }
-    return sum;
-  }
-  // Downward displacement at height y above the fixed bottom: the integral of
-  // the strain (q - alpha p) / M from the bottom up (the undrained share
-  // included through p), by the midpoint rule.
-  double displacement(double y, double t, double q, double alpha, double modulus) const {
-    const int n = 200;
-    double u = 0;
-    for (int k = 0; k < n; ++k) {
-      const double at = (k + 0.5) * y / n;
-      u += (q - alpha * pressure(H - at, t)) / modulus * y / n;
-    }
-    return u;
-  }
-};
 
 struct Result {
   double pressure_error = 0;    // worst RMS over the checks, / p0
@@ -179,54 +155,6 @@ TEST_CASE("Terzaghi on a ten times stiffer column: Aitken and IQN-ILS beat const
 }
 
 namespace {
-
-// Mandel's problem in plane strain (Abousleiman et al. 1996): a specimen 2a
-// wide pressed by rigid frictionless plates with 2F per metre of depth, sides
-// free and drained. With tan(a_n) = (1 - nu) / (nu_u - nu) a_n,
-//   p(x, t) = 2 F B (1 + nu_u) / (3a) sum sin a_n / (a_n - sin a_n cos a_n)
-//             (cos(a_n x / a) - cos a_n) exp(-a_n^2 c t / a^2),
-//   u_y(b, t) = b F / (G a) [-(1 - nu) / 2 + (1 - nu_u) sum sin a_n cos a_n /
-//             (a_n - sin a_n cos a_n) exp(-a_n^2 c t / a^2)].
-struct Mandel {
-  double a, b, force, shear, nu, nu_u, skempton, c;
-  std::vector<double> roots;
-
-  Mandel(double a_, double b_, double force_, double e, double nu_, double storage, double alpha, double mobility)
-      : a(a_), b(b_), force(force_), nu(nu_) {
-    shear = e / (2 * (1 + nu));
-    const double bulk = e / (3 * (1 - 2 * nu)), biot_modulus = 1 / storage;
-    const double undrained = bulk + alpha * alpha * biot_modulus;
-    skempton = alpha * biot_modulus / undrained;
-    nu_u = (3 * undrained - 2 * shear) / (2 * (3 * undrained + shear));
-    c = mobility * biot_modulus * (bulk + 4 * shear / 3) / (undrained + 4 * shear / 3);
-    // sin x - k x cos x changes sign once in (0, pi/2) and in each (n pi, n pi + pi/2).
-    const double k = (1 - nu) / (nu_u - nu), pi = 3.14159265358979323846;
-    for (int n = 0; n < 300; ++n) {
-      double lo = n == 0 ? 1e-9 : n * pi, hi = n * pi + pi / 2;
-      const auto f = [k](double x) { return std::sin(x) - k * x * std::cos(x); };
-      const bool rising = f(lo) < 0;
-      for (int it = 0; it < 100; ++it) {
-        const double mid = 0.5 * (lo + hi);
-        ((f(mid) < 0) == rising ? lo : hi) = mid;
-      }
-      roots.push_back(0.5 * (lo + hi));
-    }
-  }
-  double initial_pressure() const { return force * skempton * (1 + nu_u) / (3 * a); }
-  double pressure(double x, double t) const {
-    double sum = 0;
-    for (double r : roots)
-      sum += std::sin(r) / (r - std::sin(r) * std::cos(r)) * (std::cos(r * x / a) - std::cos(r)) *
-             std::exp(-r * r * c * t / (a * a));
-    return 2 * force * skempton * (1 + nu_u) / (3 * a) * sum;
-  }
-  double settlement(double t) const {  // downward, of the plate
-    double sum = 0;
-    for (double r : roots)
-      sum += std::sin(r) * std::cos(r) / (r - std::sin(r) * std::cos(r)) * std::exp(-r * r * c * t / (a * a));
-    return -b * force / (shear * a) * (-(1 - nu) / 2 + (1 - nu_u) * sum);
-  }
-};
 
 struct MandelResult {
   double pressure_error = 0;    // worst RMS over the checks, / p0
