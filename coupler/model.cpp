@@ -90,6 +90,17 @@ void choose_window_pressure(const scene::Table& root, CoupledSetup& s) {
       limit > 0 ? fmt::format("it is stable from a window of about {:.3g} s", limit)
                 : std::string("no window up to 1e4 times this one is stable"));
   const std::string stable = "scheme = \"implicit\" with window_pressure = \"end\" is stable for any window";
+  if (!cs.window_pressure && !w.iterated) {
+    // One pass: the end pressure may hold where the ramp does not.
+    stability::Window end = w;
+    end.pressure = stability::Pressure::end;
+    if (predict(regimes, end).growth.rate <= 0) {
+      cs.window_pressure = end.pressure;
+      spdlog::info("coupling: {}; the solid feels the window's end pressure instead (window_pressure = \"auto\")",
+                   why);
+      return;
+    }
+  }
   if (cs.window_pressure || !w.iterated) {
     const std::string_view key = cs.window_pressure ? "window_pressure" : "scheme";
     if (!cs.allow_unstable)

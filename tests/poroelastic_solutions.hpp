@@ -5,6 +5,8 @@
 #include <cmath>
 #include <vector>
 
+#include "coupler/model.hpp"
+
 namespace outburst::testing {
 
 // Terzaghi: p(z, t) = sum 2 p0 / M_m sin(M_m z / H) exp(-M_m^2 T), z from the
@@ -80,5 +82,19 @@ struct Mandel {
     return -b * force / (shear * a) * (-(1 - nu) / 2 + (1 - nu_u) * sum);
   }
 };
+
+// Mandel: the mean seepage pressure on the specimen's centre line x = 0 [Pa].
+inline double centre_pressure(coupling::CoupledModel& model) {
+  const auto p = model.seepage().nodal_pressure();
+  const auto& mesh = model.mapping().mesh();
+  double centre = 0;
+  int count = 0;
+  for (std::size_t i = 0; i < mesh.num_nodes(); ++i)
+    if (mesh.nodes[i].x() < 1e-9) {
+      centre += p[i];
+      ++count;
+    }
+  return centre / count;
+}
 
 }  // namespace outburst::testing

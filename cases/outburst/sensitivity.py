@@ -3,9 +3,12 @@
 paper does not give, and to resolution.
 
 usage: sensitivity.py [--outburst build/coupler/outburst] [--out results/outburst_sensitivity]
-                      [--end-time "1 s"]
+                      [--end-time "1 s"] [--only TEXT]
 writes OUT/sensitivity.md and OUT/sensitivity.csv; one run per row (one at a
-time: each uses every core), 11 minutes on 2 cores.
+time: each uses every core), 11 minutes on 2 cores for the parameter rows;
+--only runs the rows whose label holds TEXT (--only transfer: the grid
+transfer rows, PIC share 0, 0.01, 0.05 and APIC at the shipped and the double
+resolution).
 """
 import argparse
 import csv
@@ -43,6 +46,12 @@ VARIANTS = [
     # 1/6 m apart, would leave some at 44 %: refused, coupler/README.md).
     ("seepage mesh 0.25 m, 3 x 3 particles per cell", ["mpm.bodies[0].particles_per_cell=3", "FINE_MESH"]),
 ]
+# The grid transfer (the PIC share of the FLIP/PIC blend, or APIC) at the
+# shipped resolution and at twice it.
+for _grid, _cells in [("1/3 m", []), ("1/6 m", ['mpm.grid.cell_size="0.16666666666666666 m"'])]:
+    for _name, _setting in [("PIC 0 (pure FLIP)", ["mpm.flip_fraction=1.0"]), ("PIC 0.01", ["mpm.flip_fraction=0.99"]),
+                            ("PIC 0.05", ["mpm.flip_fraction=0.95"]), ("APIC", ['mpm.transfer="apic"'])]:
+        VARIANTS.append((f"transfer {_name}, grid {_grid}", _setting + _cells))
 FINE_SEEPAGE_H = 0.25
 
 
@@ -72,6 +81,9 @@ def headline(directory):
         "gas_released_m3_per_m": run.coupling["gas_released"][-1],
         "left_grid": int(run.history["removed_total"][-1]),
         "first_drop_MPa_per_m": drops[0], "last_drop_MPa_per_m": drops[1],
+        # What the transfer took and what the books leave open, of the gas work.
+        "transfer_share": run.history["transfer_J_per_m"][-1] / run.history["external_work_J_per_m"][-1],
+        "open_share": -run.history["balance_error_J_per_m"][-1] / run.history["external_work_J_per_m"][-1],
     }
 
 
@@ -80,35 +92,47 @@ def main():
     ap.add_argument("--outburst", default="build/coupler/outburst")
     ap.add_argument("--out", default="results/outburst_sensitivity")
     ap.add_argument("--end-time", default="1 s")
+    ap.add_argument("--only", default="", help="run only the rows whose label holds this text")
     args = ap.parse_args()
     os.makedirs(args.out, exist_ok=True)
     rows = []
-    mesh = fine_mesh(args.out)
-    for k, (label, overrides) in enumerate(VARIANTS):
+    chosen = [(k, v) for k, v in enumerate(VARIANTS) if args.only in v[0]]
+    mesh = fine_mesh(args.out) if any("FINE_MESH" in o for _, (_, o) in chosen) else None
+    for k, (label, overrides) in chosen:
         overrides = [mesh if o == "FINE_MESH" else o for o in overrides]
         run_dir = os.path.join(args.out, f"run_{k:02d}")
         wall, failure = run_one(args.outburst, os.path.join(HERE, "outburst.toml"),
                                 [f'scene.end_time="{args.end_time}"'] + overrides, run_dir, os.cpu_count() or 1)
         if failure:
-            raise SystemExit(f"sensitivity: {label}: {failure}")
+            # A setting that blows up is a result too: the row says where.
+            print(f"sensitivity: {label}: {failure}", flush=True)
+            rows.append({"variant": label, "wall_s": wall, "failure": failure.split("] ")[-1]})
+            continue
         row = {"variant": label, "wall_s": wall, **headline(run_dir)}
         rows.append(row)
         print(f"{label}: {row}", flush=True)
+    fields = []
+    for r in rows:
+        fields += [k for k in r if k not in fields]
     with open(os.path.join(args.out, "sensitivity.csv"), "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
+        w = csv.DictWriter(f, fieldnames=fields)
         w.writeheader()
         w.writerows(rows)
     lines = ["# Outburst: sensitivity of the headline numbers", "",
              f"Each row changes one choice of `cases/outburst/outburst.toml`; {args.end_time} simulated.", "",
              "| variant | centre / top / bottom peak speed [m/s] | farthest [m] | ejected | fully damaged "
-             "| gas released [m3/m] | steepest drop, first output / end [MPa/m] | left the grid | wall [s] |",
-             "|---|---|---|---|---|---|---|---|---|"]
+             "| gas released [m3/m] | steepest drop, first output / end [MPa/m] | left the grid "
+             "| transfer / open, of the gas work | wall [s] |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
+        if "failure" in r:
+            lines.append(f"| {r['variant']} | failed: {r['failure'][:120]} | | | | | | | | {r['wall_s']:.0f} |")
+            continue
         lines.append(f"| {r['variant']} | {r['centre_m_per_s']:.1f} / {r['top_m_per_s']:.1f} / "
                      f"{r['bottom_m_per_s']:.1f} | {r['farthest_m']:.1f} | {r['ejected_fraction']:.1%} | "
                      f"{r['fully_damaged_fraction']:.1%} | {r['gas_released_m3_per_m']:.1f} | "
                      f"{r['first_drop_MPa_per_m']:.2f} / {r['last_drop_MPa_per_m']:.2f} | {r['left_grid']} | "
-                     f"{r['wall_s']:.0f} |")
+                     f"{r['transfer_share']:.0%} / {r['open_share']:.1%} | {r['wall_s']:.0f} |")
     with open(os.path.join(args.out, "sensitivity.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
     print("\n".join(lines))
