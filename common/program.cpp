@@ -3,6 +3,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <charconv>
 
 #include <CLI/CLI.hpp>
 #include <fmt/ranges.h>
@@ -77,6 +78,27 @@ bool finish_reading(const RunOptions& options, const scene::Document& doc) {
   return true;
 }
 
+namespace {
+
+// More threads than this machine has cores only wait on each other, and
+// thousands of them overflow the OpenMP runtime's stacks.
+int most_threads() { return 4 * omp_get_num_procs(); }
+
+CLI::Validator thread_count() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        int n = -1;
+        const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), n);
+        if (ec == std::errc() && end == text.data() + text.size() && n >= 0 && n <= most_threads()) return {};
+        return fmt::format("{} is not a thread count for this machine: give 1 to {} (it has {} hardware threads), or "
+                           "0 for one per hardware thread",
+                           text, most_threads(), omp_get_num_procs());
+      },
+      fmt::format("INT in [0 - {}]", most_threads()));
+}
+
+}  // namespace
+
 int run_program(const std::string& program, const std::string& description, int argc, char** argv,
                 const std::function<int(const RunOptions&, scene::Document&)>& run) {
   CLI::App app(description, program);
@@ -92,8 +114,7 @@ int run_program(const std::string& program, const std::string& description, int 
   app.add_flag("-q,--quiet", options.quiet, "No progress line");
   app.add_option("--log-level", options.log_level, "trace, debug, info, warn, error")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
-  app.add_option("-j,--threads", options.threads, "OpenMP threads (default: all cores)")
-      ->check(CLI::NonNegativeNumber);
+  app.add_option("-j,--threads", options.threads, "OpenMP threads (default: all cores)")->check(thread_count());
   app.set_version_flag("--version", std::string(version));
   try {
     app.parse(argc, argv);
@@ -105,7 +126,13 @@ int run_program(const std::string& program, const std::string& description, int 
   logger->set_pattern("[%H:%M:%S] [%n] [%^%l%$] %v");
   spdlog::set_default_logger(logger);
   spdlog::set_level(spdlog::level::from_str(options.log_level));
-  if (options.threads > 0) omp_set_num_threads(options.threads);
+  if (options.threads > 0) {
+    omp_set_num_threads(options.threads);
+  } else if (omp_get_max_threads() > most_threads()) {
+    spdlog::warn("OMP_NUM_THREADS asks for {} threads; running {}, one per hardware thread", omp_get_max_threads(),
+                 omp_get_num_procs());
+    omp_set_num_threads(omp_get_num_procs());
+  }
 
   try {
     auto doc = scene::Document::load(options.scene, options.overrides);
