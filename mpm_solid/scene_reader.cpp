@@ -264,8 +264,8 @@ Setup read_setup(const scene::Table& s) {
     if (found == names.end())
       b.fail("material", fmt::format("no material \"{}\" (defined: {})", material, fmt::join(names, ", ")));
     const int index = static_cast<int>(found - names.begin());
-    const int ppc = static_cast<int>(b.integer({"particles_per_cell", "n for n x n particles per cell", "2",
-                                                Range::between(1, 8)}));
+    const int ppc = b.integer<int>({"particles_per_cell", "n for n x n particles per cell", "2",
+                                    Range::between(1, 8)});
     std::vector<Vec<2>> points;
     if (b.has("polygon")) {
       std::vector<Vec<2>> polygon;

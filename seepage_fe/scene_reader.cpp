@@ -34,14 +34,14 @@ std::variant<Mesh, StructuredMeshSpec> read_mesh(const scene::Table& t) {
   StructuredMeshSpec spec;
   const auto origin = t.quantity_vector({"origin", "lower-left corner", "0 m, 0 m"}, units::length, 2);
   const auto size = t.quantity_vector({"size", "width and height", "", Range::positive()}, units::length, 2);
-  const auto cells = t.integer_vector({"cells", "number of cells along x and y", "", Range::at_least(1)}, 2);
+  const auto cells = t.integer_vector<int>({"cells", "number of cells along x and y", "", Range::at_least(1)}, 2);
   const auto grading = t.number_vector(
       {"grading", "ratio of the last to the first cell size along x and y (1: uniform)", "1, 1",
        Range::positive()},
       2);
   spec.origin = {origin[0], origin[1]};
   spec.size = {size[0], size[1]};
-  spec.cells = {static_cast<int>(cells[0]), static_cast<int>(cells[1])};
+  spec.cells = {cells[0], cells[1]};
   spec.grading = {grading[0], grading[1]};
   return spec;
 }
@@ -110,10 +110,10 @@ Setup read_setup(const scene::Table& s, bool own_time_steps) {
                   : NonlinearMethod::picard;
   st.tolerance = s.number({"tolerance", "nonlinear convergence: max |du| / max |u|", "1e-10",
                            Range::positive()});
-  st.max_iterations = static_cast<int>(s.integer(
-      {"max_iterations", "nonlinear iterations before the step is cut", "30", Range::at_least(1)}));
-  st.max_step_cuts = static_cast<int>(s.integer(
-      {"max_step_cuts", "halvings of a failing step before the run stops", "12", Range::at_least(0)}));
+  st.max_iterations = s.integer<int>(
+      {"max_iterations", "nonlinear iterations before the step is cut", "30", Range::at_least(1)});
+  st.max_step_cuts = s.integer<int>(
+      {"max_step_cuts", "halvings of a failing step before the run stops", "12", Range::at_least(0)});
 
   setup.steps.maximum = std::numeric_limits<double>::infinity();
   if (own_time_steps) {

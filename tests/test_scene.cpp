@@ -92,6 +92,22 @@ TEST_CASE("broken scenes are rejected with file, line, key and what was expected
       {replace(valid, "[scene]", "[scene\n"), {"broken.toml:1:", "not valid TOML"}},
       {replace(valid, "[seepage.mesh]\n", "[seepage.mesh]\ntype = \"gmsh\"\nfile = \"nowhere.msh\"\n"),
        {"seepage.mesh.file", "does not exist"}},
+      // Integers are checked against the int they are stored in (before: a 1 x 1
+      // mesh, and -1294967296 Newton iterations).
+      {replace(valid, "cells = [10, 1]", "cells = [4294967297, 1]"),
+       {"broken.toml:8:9", "seepage.mesh.cells", "each entry must be >= 1 and <= 2147483647, got 4294967297"}},
+      {replace(valid, "[seepage]\n", "[seepage]\nmax_iterations = 3000000000\n"),
+       {"broken.toml:5:18", "seepage.max_iterations", "must be >= 1 and <= 2147483647, got 3000000000"}},
+      {replace(valid, "[seepage.mesh]\n", "[seepage.mesh]\ntype = \"gmsh\"\nfile = \".\"\n"),
+       {"seepage.mesh.file", "\".\" is a directory", "expected a file"}},
+      {replace(valid, "end_time = \"1 d\"", "end_time = \"1e308 d\""),
+       {"broken.toml:3:12", "scene.end_time", "\"1e308 d\" overflows"}},
+      // A misspelt key or section is named beside the key it leaves missing.
+      {replace(valid, "time_step = \"1 h\"", "time_stepp = \"1 h\""),
+       {"seepage.time_step", "required key is missing",
+        "the scene has 'seepage.time_stepp' (broken.toml:5:14), which nothing reads: misspelt?"}},
+      {replace(valid, "[seepage.mesh]", "[seepage.mesj]"),
+       {"seepage.mesh", "required section [seepage.mesh] is missing", "'seepage.mesj'", "misspelt?"}},
   };
   for (const auto& row : rows) {
     INFO(row.scene);
@@ -122,6 +138,15 @@ TEST_CASE("command-line overrides replace scene keys and are checked like them",
                     Catch::Contains("no table regions[3]"));
   CHECK_THROWS_WITH(read_seepage_scene(valid, {"seepage.regions[x].lambda=\"1 m2/(MPa2 d)\""}),
                     Catch::Contains("'x' is not an index"));
+  // An index beyond 2^64 (before: "stoul").
+  CHECK_THROWS_WITH(read_seepage_scene(valid, {"seepage.regions[18446744073709551617].lambda=\"1 m2/(MPa2 d)\""}),
+                    Catch::Contains("the scene has no table regions[18446744073709551617]"));
+}
+
+TEST_CASE("a scene that is not a regular file is refused before it is read", "[scene]") {
+  // Before: /dev/zero was read without end.
+  CHECK_THROWS_WITH(scene::Document::load("/dev/zero"), Catch::Contains("/dev/zero: the scene is a device"));
+  CHECK_THROWS_WITH(scene::Document::load(OUTBURST_SOURCE_DIR), Catch::Contains("the scene is a directory"));
 }
 
 TEST_CASE("explain lists every key read, marking defaults", "[scene]") {
