@@ -11,6 +11,7 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
+#include "common/limits.hpp"
 #include "common/progress.hpp"
 #include "common/version.hpp"
 
@@ -51,10 +52,14 @@ SceneHeader read_scene_header(const scene::Table& root) {
   }
   const auto o = root.table("output", "what is written and how often", false);
   h.output_interval = h.end_time / 10;
-  if (o && o->has("interval"))
+  if (o && o->has("interval")) {
     h.output_interval = o->quantity({"interval", "simulated time between snapshots (default: end_time / 10)",
                                      "", scene::Range::positive()},
                                     units::time);
+    limits::refuse_count(*o, "interval", h.end_time / h.output_interval, limits::max_snapshots, "snapshots",
+                         fmt::format("end_time {:.3g} s / interval {:.3g} s, a file each; lengthen the interval",
+                                     h.end_time, h.output_interval));
+  }
   return h;
 }
 

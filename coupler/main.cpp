@@ -5,6 +5,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "common/limits.hpp"
 #include "common/program.hpp"
 #include "common/progress.hpp"
 #include "coupler/model.hpp"
@@ -42,8 +43,19 @@ class WindowLog {
   std::size_t fields_;
 };
 
+// Refuses a run of more windows or MPM steps than any run may take.
+void check_run_length(scene::Table root, const coupling::CoupledSetup& setup) {
+  const double end_time = setup.header.end_time, window = setup.coupling.window;
+  limits::refuse_count(*root.table("coupling", "", true), "window", end_time / window, limits::max_steps,
+                       "coupling windows",
+                       fmt::format("end_time {:.3g} s / window {:.3g} s; lengthen the window", end_time, window));
+  mpm::check_run_length(*root.table("mpm", "", true), setup.solid, end_time);
+}
+
 int run(const RunOptions& options, scene::Document& doc) {
   coupling::CoupledSetup setup = coupling::read_coupled_setup(doc.root());
+  doc.reject_unused();
+  check_run_length(doc.root(), setup);
   if (!finish_reading(options, doc)) return 0;
   const SceneHeader header = setup.header;
   const auto tracers = setup.solid.tracers;

@@ -16,8 +16,10 @@ int run(const RunOptions& options, scene::Document& doc) {
   auto root = doc.root();
   const SceneHeader header = read_scene_header(root);
   require_solvers(root, header, {"mpm"}, "mpm-solid");
-  mpm::Setup setup = mpm::read_setup(*root.table("mpm", "the material point solver", true));
+  const auto mpm_table = root.table("mpm", "the material point solver", true);
+  mpm::Setup setup = mpm::read_setup(*mpm_table);
   doc.reject_unused();
+  mpm::check_run_length(*mpm_table, setup, header.end_time);
 
   // The particles exist now: a fixed step can be checked against their CFL limit
   // (before --check returns, so it catches an unstable step too).

@@ -17,7 +17,9 @@ int run(const RunOptions& options, scene::Document& doc) {
   auto root = doc.root();
   const SceneHeader header = read_scene_header(root);
   require_solvers(root, header, {"seepage"}, "seepage-fe");
-  seepage::Setup setup = seepage::read_setup(*root.table("seepage", "the gas seepage solver", true));
+  const auto seepage_table = root.table("seepage", "the gas seepage solver", true);
+  seepage::Setup setup = seepage::read_setup(*seepage_table);
+  seepage::check_run_length(*seepage_table, setup.steps, header.end_time, header.output_interval);
   if (!finish_reading(options, doc)) return 0;
 
   const auto wall_start = std::chrono::steady_clock::now();
