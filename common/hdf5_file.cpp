@@ -41,6 +41,14 @@ class Handle {
   herr_t (*close_)(hid_t);
 };
 
+// Variable-length UTF-8 strings (h5py reads them as str).
+hid_t string_type() {
+  const hid_t type = H5Tcopy(H5T_C_S1);
+  H5Tset_size(type, H5T_VARIABLE);
+  H5Tset_cset(type, H5T_CSET_UTF8);
+  return type;
+}
+
 void write_dataset(hid_t file, const std::filesystem::path& name, const std::string& path,
                    hid_t file_type, hid_t memory_type, const void* data,
                    const std::vector<std::size_t>& dims) {
@@ -88,12 +96,13 @@ void H5Writer::attribute(const std::string& object, const std::string& name,
                          const std::string& value) {
   Handle obj(H5Oopen(file_, object.c_str(), H5P_DEFAULT), H5Oclose);
   if (!obj.valid()) fail(final_path_, fmt::format("no object {} for attribute {}", object, name));
-  Handle type(H5Tcopy(H5T_C_S1), H5Tclose);
-  H5Tset_size(type, std::max<std::size_t>(1, value.size()));
-  H5Tset_strpad(type, H5T_STR_NULLPAD);
+  // Variable length: the text lives in the file's heap, not in the object
+  // header, whose 64 kB limit a fixed-length scene text overran.
+  Handle type(string_type(), H5Tclose);
   Handle space(H5Screate(H5S_SCALAR), H5Sclose);
   Handle attr(H5Acreate2(obj, name.c_str(), type, space, H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
-  if (!attr.valid() || H5Awrite(attr, type, value.empty() ? "" : value.data()) < 0)
+  const char* text = value.c_str();
+  if (!attr.valid() || H5Awrite(attr, type, &text) < 0)
     fail(final_path_, fmt::format("cannot write attribute {} on {}", name, object));
 }
 
@@ -166,6 +175,16 @@ std::string H5Reader::string_attribute(const std::string& object, const std::str
               H5Aclose);
   if (!attr.valid()) fail(path_, fmt::format("no attribute {} on {}", name, object));
   Handle type(H5Aget_type(attr), H5Tclose);
+  if (H5Tis_variable_str(type) > 0) {
+    Handle memory_type(string_type(), H5Tclose);
+    char* text = nullptr;
+    if (H5Aread(attr, memory_type, &text) < 0 || !text)
+      fail(path_, fmt::format("cannot read attribute {} on {}", name, object));
+    std::string value(text);
+    H5free_memory(text);
+    return value;
+  }
+  // Fixed length, as files of earlier versions hold.
   std::string value(H5Tget_size(type), '\0');
   if (H5Aread(attr, type, value.data()) < 0)
     fail(path_, fmt::format("cannot read attribute {} on {}", name, object));

@@ -71,3 +71,19 @@ TEST_CASE("a series writes mesh, snapshots and an index listing only complete sn
   CHECK(r.string_attribute("/mesh/p", "unit") == "Pa");
   CHECK(r.number_attribute("/", "time") == 1.0);
 }
+
+TEST_CASE("a scene text of any size is kept in every output file", "[output]") {
+  const auto dir = fresh_dir("big_scene");
+  // Before: over 64 kB the fixed-length attribute could not be written.
+  std::string text = "[scene]\ntitle = \"big\"\n";
+  while (text.size() < 300000) text += "# a long comment, as a big polygon or a long note would make it\n";
+  output::RunInfo info{"test", "0.0", "scene.toml", text, {}, "SI"};
+  output::FieldSeries series(dir, "run", info);
+  series.add_point_grid("particles");
+  output::Snapshot snap(0);
+  snap.set_points("particles", {0.5, 0.5, 0});
+  series.write(snap);
+  hdf5::H5Reader r(dir / "run_000000.h5");
+  CHECK(r.string_attribute("/", "scene_text") == text);
+  CHECK(r.string_attribute("/", "program") == "test");
+}
