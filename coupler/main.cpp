@@ -2,6 +2,7 @@
 // solver run as partners of a coupling (coupler/coupling.hpp) window by window.
 #include <chrono>
 #include <fstream>
+#include <stdexcept>
 
 #include <spdlog/spdlog.h>
 
@@ -36,6 +37,7 @@ class WindowLog {
       out_ << (k < r.residuals.size() ? fmt::format(",{:.3e}", r.residuals[k]) : std::string(","));
     out_ << '\n';
     out_.flush();
+    if (!out_) throw std::runtime_error("cannot write coupling.csv: the disk may be full");
   }
 
  private:
@@ -75,8 +77,14 @@ int run(const RunOptions& options, scene::Document& doc) {
   seepage::Output seepage_out(directory, info, seepage_solver);
   mpm::Output solid_out(directory, info, tracers);
   WindowLog log(directory / "coupling.csv", cs.scheme.to_first);
-  seepage_out.snapshot(seepage_solver);
-  solid_out.snapshot(solid);
+  seepage_out.series().list_with_others();
+  solid_out.series().list_with_others();
+  const auto snapshot = [&] {
+    seepage_out.snapshot(seepage_solver);
+    solid_out.snapshot(solid);
+    output::publish({&seepage_out.series(), &solid_out.series()});
+  };
+  snapshot();
 
   const auto wall_start = std::chrono::steady_clock::now();
   Progress progress("outburst", 0.0, header.end_time, options.show_progress());
@@ -99,8 +107,7 @@ int run(const RunOptions& options, scene::Document& doc) {
     const bool output_due = coupler.time() >= target * (1 - 1e-12);
     at_rest = rest.at_rest(kinetic);
     if (output_due || at_rest) {
-      seepage_out.snapshot(seepage_solver);
-      solid_out.snapshot(solid);
+      snapshot();
       if (output_due) next_output += header.output_interval;
     }
     if (at_rest) break;

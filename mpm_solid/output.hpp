@@ -23,6 +23,7 @@ class Output {
   void snapshot(const Solver& solver);
   void history(const Solver& solver, const StepInfo& step);
   const output::FieldSeries& series() const { return series_; }
+  output::FieldSeries& series() { return series_; }
 
  private:
   output::FieldSeries series_;
