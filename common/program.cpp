@@ -114,6 +114,8 @@ int run_program(const std::string& program, const std::string& description, int 
                  "Override a scene key: dotted.key=<TOML value>, e.g. "
                  "--set seepage.time_step='\"30 min\"'");
   app.add_flag("--check", options.check_only, "Validate the scene and stop");
+  app.add_flag("--overwrite", options.overwrite,
+               "Replace the files of an earlier run in the output folder (otherwise such a folder is refused)");
   app.add_flag("--explain", options.explain,
                "Print every key the scene uses with its value, default and meaning");
   app.add_flag("-q,--quiet", options.quiet, "No progress line");

@@ -24,6 +24,7 @@ struct RunOptions {
   std::filesystem::path output;  // empty: results/<scene name>
   std::vector<std::string> overrides;
   bool check_only = false;   // read and validate the scene, run nothing
+  bool overwrite = false;    // replace an earlier run's files in the output folder
   bool explain = false;      // print every key the scene uses, with defaults
   bool quiet = false;        // no progress line
   std::string log_level = "info";

@@ -7,6 +7,7 @@
 #include <spdlog/spdlog.h>
 
 #include "common/limits.hpp"
+#include "common/output_folder.hpp"
 #include "common/program.hpp"
 #include "common/progress.hpp"
 #include "coupler/model.hpp"
@@ -59,6 +60,7 @@ int run(const RunOptions& options, scene::Document& doc) {
   doc.reject_unused();
   check_run_length(doc.root(), setup);
   if (!finish_reading(options, doc)) return 0;
+  const OutputFolder folder(options.output_directory(), "outburst", options.overwrite);
   const SceneHeader header = setup.header;
   const auto tracers = setup.solid.tracers;
   coupling::CoupledModel model(std::move(setup));
@@ -71,7 +73,7 @@ int run(const RunOptions& options, scene::Document& doc) {
   spdlog::info("{}: {} seepage cells, {} particles, window {:.3g} s", header.title, model.mapping().mesh().num_cells(),
                solid.particles().size(), cs.window);
 
-  const auto directory = options.output_directory();
+  const auto& directory = folder.path();
   const auto info = run_info("outburst", doc, "SI: m, s, kg, Pa; 2D plane strain, per metre of depth; MPM stresses "
                                               "are effective (total = effective - alpha p I)");
   seepage::Output seepage_out(directory, info, seepage_solver);

@@ -3,6 +3,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "common/output_folder.hpp"
 #include "common/program.hpp"
 #include "common/progress.hpp"
 #include "mpm_solid/output.hpp"
@@ -31,6 +32,7 @@ int run(const RunOptions& options, scene::Document& doc) {
         "use a smaller step or drop the key to let the CFL condition choose",
         doc.file().string(), *setup.fixed_time_step, stable / setup.settings.courant));
   if (!finish_reading(options, doc)) return 0;
+  const OutputFolder folder(options.output_directory(), "mpm-solid", options.overwrite);
   spdlog::info("{}: {} particles, {} x {} cells of {:g} m, stable step {:.3g} s", header.title,
                solver.particles().size(), setup.grid.cells[0], setup.grid.cells[1], setup.grid.h, stable);
 
@@ -40,7 +42,7 @@ int run(const RunOptions& options, scene::Document& doc) {
     spdlog::info("settled for {:.3g} s: kinetic energy down to {:.2e} of its peak; supports removed",
                  setup.settling.duration, left);
   }
-  mpm::Output out(options.output_directory(), run_info("mpm-solid", doc, "SI: m, s, kg, Pa; 2D plane strain, "
+  mpm::Output out(folder.path(), run_info("mpm-solid", doc, "SI: m, s, kg, Pa; 2D plane strain, "
                                                                          "per metre of depth"),
                   setup.tracers);
   out.snapshot(solver);

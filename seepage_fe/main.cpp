@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 
 #include "common/blas.hpp"
+#include "common/output_folder.hpp"
 #include "common/program.hpp"
 #include "common/progress.hpp"
 #include "seepage_fe/output.hpp"
@@ -30,8 +31,8 @@ int run(const RunOptions& options, scene::Document& doc) {
                solver.mesh().num_nodes(), solver.mesh().num_cells(), gas ? "gas" : "linear",
                format_duration(header.end_time));
 
-  const auto directory = options.output_directory();
-  seepage::Output out(directory, run_info("seepage-fe", doc, gas ? "SI: m, s, Pa; P = p^2 in Pa^2; "
+  const OutputFolder folder(options.output_directory(), "seepage-fe", options.overwrite);
+  seepage::Output out(folder.path(), run_info("seepage-fe", doc, gas ? "SI: m, s, Pa; P = p^2 in Pa^2; "
                                                                   "gas volumes at standard conditions"
                                                                 : "SI: m, s, Pa"),
                       solver);
