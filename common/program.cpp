@@ -13,6 +13,7 @@
 
 #include "common/limits.hpp"
 #include "common/progress.hpp"
+#include "common/stop.hpp"
 #include "common/version.hpp"
 
 namespace outburst {
@@ -133,6 +134,7 @@ int run_program(const std::string& program, const std::string& description, int 
   logger->set_pattern("[%H:%M:%S] [%n] [%^%l%$] %v");
   spdlog::set_default_logger(logger);
   spdlog::set_level(spdlog::level::from_str(options.log_level));
+  install_stop_handlers();
   if (options.threads > 0) {
     omp_set_num_threads(options.threads);
   } else if (omp_get_max_threads() > most_threads()) {

@@ -5,7 +5,8 @@
 //             [--quiet] [--log-level LEVEL] [--threads N]
 //
 // and the one place that turns exceptions into exit codes: 2 for a bad scene or
-// command line (with the file, line and key), 1 for a run that failed.
+// command line (with the file, line and key), 1 for a run that failed. A run
+// stopped by SIGINT or SIGTERM ends with exit_stopped, 3 (common/stop.hpp).
 
 #include <algorithm>
 #include <filesystem>

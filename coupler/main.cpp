@@ -10,6 +10,7 @@
 #include "common/output_folder.hpp"
 #include "common/program.hpp"
 #include "common/progress.hpp"
+#include "common/stop.hpp"
 #include "coupler/model.hpp"
 #include "mpm_solid/output.hpp"
 #include "seepage_fe/output.hpp"
@@ -108,9 +109,13 @@ int run(const RunOptions& options, scene::Document& doc) {
                     fmt::format("sub-iterations {}", r.iterations));
     const bool output_due = coupler.time() >= target * (1 - 1e-12);
     at_rest = rest.at_rest(kinetic);
-    if (output_due || at_rest) {
+    if (output_due || at_rest || stop_requested()) {
       snapshot();
       if (output_due) next_output += header.output_interval;
+    }
+    if (stop_requested()) {
+      progress.finish();
+      return report_stop(coupler.time(), directory);
     }
     if (at_rest) break;
   }

@@ -6,6 +6,7 @@
 #include "common/output_folder.hpp"
 #include "common/program.hpp"
 #include "common/progress.hpp"
+#include "common/stop.hpp"
 #include "mpm_solid/output.hpp"
 #include "mpm_solid/scene_reader.hpp"
 
@@ -68,10 +69,14 @@ int run(const RunOptions& options, scene::Document& doc) {
     progress.update(solver.steps(), solver.time(), dt, fmt::format("particles {}", solver.particles().size()));
     const bool output_due = solver.time() >= target * (1 - 1e-12);
     at_rest = rest.active() && rest.at_rest(solver.kinetic_energy());
-    if (output_due || at_rest) {
+    if (output_due || at_rest || stop_requested()) {
       out.snapshot(solver);
       last_snapshot_time = solver.time();
       if (output_due) next_output += header.output_interval;
+    }
+    if (stop_requested()) {
+      progress.finish();
+      return report_stop(solver.time(), out.series().index_path());
     }
     if (at_rest) break;
   }

@@ -7,6 +7,7 @@
 #include "common/output_folder.hpp"
 #include "common/program.hpp"
 #include "common/progress.hpp"
+#include "common/stop.hpp"
 #include "seepage_fe/output.hpp"
 #include "seepage_fe/scene_reader.hpp"
 
@@ -50,9 +51,12 @@ int run(const RunOptions& options, scene::Document& doc) {
     out.history(solver, h, report);
     progress.update(solver.steps(), solver.time(), h,
                     fmt::format("iterations {}", report.nonlinear_iterations));
-    if (solver.time() >= target * (1 - 1e-12)) {
-      out.snapshot(solver);
-      next_output += header.output_interval;
+    const bool output_due = solver.time() >= target * (1 - 1e-12);
+    if (output_due || stop_requested()) out.snapshot(solver);
+    if (output_due) next_output += header.output_interval;
+    if (stop_requested()) {
+      progress.finish();
+      return report_stop(solver.time(), out.series().index_path());
     }
     // A step shortened to land on an output time does not shrink the next one.
     if (h == dt) dt = std::min(dt * setup.steps.growth, setup.steps.maximum);
