@@ -62,6 +62,17 @@ std::string with_article(const std::string& noun) {
   return (vowel ? "an " : "a ") + noun;
 }
 
+// ", such as \"3 s\"" (or an array of `count` of them), in the dimension's
+// unit; empty for a dimension no single unit has.
+std::string example(double value, const units::Dimension& dimension, std::size_t count = 0) {
+  const std::string unit = units::symbol(dimension);
+  if (unit.empty()) return {};
+  if (count == 0) return fmt::format(", such as \"{:g} {}\"", value, unit);
+  std::string items;
+  for (std::size_t k = 0; k < count; ++k) items += fmt::format("{}\"{:g} {}\"", k ? ", " : "", value + k, unit);
+  return ", such as [" + items + "]";
+}
+
 // Angle keys are written in degrees, so their ranges are shown in degrees;
 // the others in SI.
 std::string range_text(const Range& range, const units::Dimension& dimension) {
@@ -93,11 +104,20 @@ std::size_t edit_distance(std::string_view a, std::string_view b) {
   return d[a.size()][b.size()];
 }
 
-// One slip of the keyboard, or two in a long name; short names differ too
-// little to tell a slip from another key.
+// "bodies" -> "body", "regions" -> "region".
+std::string singular(std::string_view word) {
+  if (word.ends_with("ies")) return std::string(word.substr(0, word.size() - 3)) + "y";
+  if (word.ends_with("s")) return std::string(word.substr(0, word.size() - 1));
+  return std::string(word);
+}
+
+// One slip of the keyboard (two in a long name), a plural for a singular or
+// the other way round, or a few letters too many ("scenery"); short names
+// differ too little to tell a slip from another key.
 bool looks_misspelt(std::string_view written, std::string_view meant) {
   if (written == meant || meant.size() < 4) return false;
-  return edit_distance(written, meant) <= (std::min(written.size(), meant.size()) >= 10 ? 2 : 1);
+  return edit_distance(written, meant) <= (std::min(written.size(), meant.size()) >= 10 ? 2 : 1) ||
+         singular(written) == singular(meant) || (written.starts_with(meant) && written.size() <= meant.size() + 3);
 }
 
 std::string join(const std::vector<std::string_view>& words) {
@@ -253,31 +273,29 @@ std::string Document::located(const toml::node* n, const std::string& key_path,
 }
 
 std::string Document::misspelling_hint(const std::string& key_path) const {
-  std::vector<std::string> parts;
-  for (std::string_view rest = key_path; !rest.empty();) {
-    const auto dot = rest.find('.');
-    std::string part(rest.substr(0, dot));
-    part.resize(std::min(part.size(), part.find('[')));
-    parts.push_back(part);
-    if (dot == std::string_view::npos) break;
-    rest.remove_prefix(dot + 1);
-  }
+  // Along the path, each table's unread keys against the name wanted there:
+  // a misspelt key is a sibling of the missing one or of a table above it.
   std::vector<std::string> suspects;
-  const std::function<void(const toml::table&, const std::string&)> walk = [&](const toml::table& table,
-                                                                              const std::string& path) {
-    for (const auto& [k, v] : table) {
-      const std::string name(k.str());
-      const std::string at = path.empty() ? name : path + "." + name;
-      if (!used_.count(&v) &&
-          std::any_of(parts.begin(), parts.end(), [&](const std::string& p) { return looks_misspelt(name, p); }))
-        suspects.push_back(fmt::format("'{}' ({}:{}:{})", at, file_.string(), v.source().begin.line,
+  const toml::table* table = root_.get();
+  std::string at;
+  for (std::string_view rest = key_path; table && !rest.empty();) {
+    const auto dot = rest.find('.');
+    const std::string_view part = rest.substr(0, dot);
+    const std::string name(part.substr(0, part.find('[')));
+    for (const auto& [k, v] : *table)
+      if (!used_.count(&v) && looks_misspelt(k.str(), name))
+        suspects.push_back(fmt::format("'{}{}' ({}:{}:{})", at, k.str(), file_.string(), v.source().begin.line,
                                        v.source().begin.column));
-      if (const auto* sub = v.as_table()) walk(*sub, at);
-      if (const auto* arr = v.as_array(); arr && arr->is_array_of_tables())
-        for (std::size_t i = 0; i < arr->size(); ++i) walk(*arr->get(i)->as_table(), fmt::format("{}[{}]", at, i));
+    const toml::node* next = table->get(name);
+    if (next && part.find('[') != std::string_view::npos) {
+      std::size_t index = 0;
+      std::from_chars(part.data() + part.find('[') + 1, part.data() + part.size(), index);
+      next = next->is_array() ? next->as_array()->get(index) : nullptr;
     }
-  };
-  walk(*root_, "");
+    table = next ? next->as_table() : nullptr;
+    at += std::string(part) + ".";
+    rest = dot == std::string_view::npos ? std::string_view() : rest.substr(dot + 1);
+  }
   if (suspects.empty()) return {};
   std::string list;
   for (const auto& s : suspects) list += (list.empty() ? "" : ", ") + s;
@@ -389,9 +407,8 @@ std::pair<double, units::Dimension> Table::quantity_of(const Key& key,
   if (n) {
     if (!n->is_string()) {
       if (n->is_number())
-        fail(key.name, fmt::format("expected {} with its unit as a string, such as \"{}\"; "
-                                   "a bare number has no unit",
-                                   expected, key.fallback.empty() ? "1 m" : key.fallback));
+        fail(key.name, fmt::format("expected {} with its unit as a string{}; a bare number has no unit", expected,
+                                   example(n->value<double>().value_or(1), a)));
       fail(key.name, fmt::format("expected {} with its unit as a string", expected));
     }
     text = n->as_string()->get();
@@ -424,9 +441,8 @@ std::vector<double> Table::quantity_vector(const Key& key, const units::Dimensio
   if (n) {
     const auto* arr = n->as_array();
     if (!arr || arr->size() != count)
-      fail(key.name, fmt::format("expected an array of {} {} values with units, such as "
-                                 "[\"0 m\", \"1 m\"]",
-                                 count, units::describe(dimension)));
+      fail(key.name, fmt::format("expected an array of {} {} values with units{}", count, units::describe(dimension),
+                                 example(0, dimension, count)));
     for (const auto& item : *arr) {
       if (!item.is_string())
         fail(key.name, fmt::format("expected each entry as {} with its unit, as a string",

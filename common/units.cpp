@@ -49,8 +49,8 @@ constexpr std::array<NamedUnit, 33> known_units{{
     {"kJ", 1e3, {2, 1, -2, 0}},
     {"MJ", 1e6, {2, 1, -2, 0}},
     {"W", 1.0, {2, 1, -3, 0}},
-    {"rad", 1.0, angle},
     {"deg", pi / 180.0, angle},
+    {"rad", 1.0, angle},
     {"L", 1e-3, {3, 0, 0, 0}},
     {"Hz", 1.0, {0, 0, -1, 0}},
     {"mPa", 1e-3, pressure},
@@ -62,7 +62,7 @@ struct NamedDimension {
   Dimension dimension;
 };
 
-const std::array<NamedDimension, 19> named_dimensions{{
+const std::array<NamedDimension, 20> named_dimensions{{
     {"dimensionless number", dimensionless},
     {"length", length},
     {"mass", mass},
@@ -81,6 +81,7 @@ const std::array<NamedDimension, 19> named_dimensions{{
     {"gas content coefficient per mass (volume / (mass pressure^1/2))",
      gas_content_per_mass},
     {"force per length", {0, 1, -2, 0}},
+    {"force", {1, 1, -2, 0}},
     {"frequency", {0, 0, -1, 0}},
     {"energy", {2, 1, -2, 0}},
 }};
@@ -245,6 +246,12 @@ std::string describe(const Dimension& d) {
     formula += near(exponent, 1) ? std::string(symbol) : fmt::format("{}^{:g}", symbol, exponent);
   }
   return formula;
+}
+
+std::string symbol(const Dimension& d) {
+  for (const auto& u : known_units)
+    if (u.dimension == d) return std::string(u.symbol);
+  return {};
 }
 
 Quantity parse_unit(std::string_view unit_expression) {

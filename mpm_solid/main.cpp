@@ -28,10 +28,10 @@ int run(const RunOptions& options, scene::Document& doc) {
   mpm::Solver solver(setup.grid, std::move(setup.materials), std::move(setup.particles), setup.settings);
   const double stable = solver.stable_time_step();
   if (setup.fixed_time_step && *setup.fixed_time_step > stable / setup.settings.courant)
-    throw scene::Error(fmt::format(
-        "{}: key 'mpm.time_step': {:.3g} s exceeds the stability limit h / (c + |v|) = {:.3g} s of this scene; "
-        "use a smaller step or drop the key to let the CFL condition choose",
-        doc.file().string(), *setup.fixed_time_step, stable / setup.settings.courant));
+    mpm_table->fail("time_step", fmt::format("{:.3g} s exceeds the stability limit h / (c + |v|) = {:.3g} s of this "
+                                             "scene; use a smaller step or drop the key to let the CFL condition "
+                                             "choose",
+                                             *setup.fixed_time_step, stable / setup.settings.courant));
   if (!finish_reading(options, doc)) return 0;
   const OutputFolder folder(options.output_directory(), "mpm-solid", options.overwrite);
   spdlog::info("{}: {} particles, {} x {} cells of {:g} m, stable step {:.3g} s", header.title,

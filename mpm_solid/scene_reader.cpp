@@ -66,6 +66,15 @@ void read_platens(const scene::Table& s, Settings& st, const Grid<2>& grid) {
     if (!(hiv.array() > lov.array()).all()) t.fail("box_max", "must lie above and right of box_min");
     if ((hiv.array() < grid.lower.array()).any() || (lov.array() > grid.upper.array()).any())
       t.fail("box_min", "the platen lies outside the grid");
+    // Grid nodes lie every h from the grid's corner, ghost nodes included.
+    for (int d = 0; d < 2; ++d) {
+      const double first = std::max(std::ceil((lov[d] - grid.lower[d]) / grid.h), -1.0 * Grid<2>::ghost);
+      const double last = std::min(std::floor((hiv[d] - grid.lower[d]) / grid.h), 1.0 * grid.cells[d] + Grid<2>::ghost);
+      if (first > last)
+        t.fail("box_min", fmt::format("the platen's box holds no grid node: along {} the nodes lie every {:g} m from "
+                                      "{:g} m",
+                                      d == 0 ? 'x' : 'y', grid.h, grid.lower[d]));
+    }
     const std::string direction =
         t.choice({"direction", "the axis the plate moves along: \"x\" or \"y\""}, {"x", "y"});
     const double force = t.quantity({"force", "load on the plate along that axis per metre of depth (negative: "

@@ -327,13 +327,13 @@ Mesh read_gmsh(const std::filesystem::path& file, double length_scale) {
   Mesh mesh;
   std::unordered_map<long, int> index;
   std::map<int, int> region_of_physical;
-  const auto node_index = [&](long tag) {
+  const auto node_index = [&](long tag, int line) {
     const auto found = index.find(tag);
     if (found != index.end()) return found->second;
     const auto xy = node_xy.find(tag);
     if (xy == node_xy.end())
       throw std::runtime_error(
-          fmt::format("{}: an element uses node {}, which $Nodes does not define", file.string(), tag));
+          fmt::format("{}:{}: the element uses node {}, which $Nodes does not define", file.string(), line, tag));
     const int i = static_cast<int>(mesh.nodes.size());
     mesh.nodes.push_back(xy->second);
     index[tag] = i;
@@ -351,7 +351,7 @@ Mesh read_gmsh(const std::filesystem::path& file, double length_scale) {
   }
   for (const auto& c : raw_cells) {
     std::array<int, 4> cell{};
-    for (int k = 0; k < 4; ++k) cell[k] = node_index(c.tags[k]);
+    for (int k = 0; k < 4; ++k) cell[k] = node_index(c.tags[k], c.line);
     const auto [it, added] =
         region_of_physical.try_emplace(c.physical, static_cast<int>(mesh.region_names.size()));
     if (added) {
