@@ -15,7 +15,7 @@ import tomllib
 PROGRAMS = {"seepage-fe": "seepage_fe/seepage-fe", "mpm-solid": "mpm_solid/mpm-solid", "outburst": "coupler/outburst"}
 # What escapes when an exception is not turned into a message of ours.
 RAW = ["terminate called", "what():", "std::", "basic_string", "stoul", "stod", "bad_alloc", "max_size()",
-       "filesystem error", "Segmentation", "Aborted"]
+       "filesystem error", "Segmentation", "Aborted", "runtime error:", "AddressSanitizer", "LeakSanitizer"]
 
 
 def replaced(text, edits, what):
