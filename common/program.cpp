@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <new>
 
 #include <CLI/CLI.hpp>
 #include <fmt/ranges.h>
@@ -149,6 +150,12 @@ int run_program(const std::string& program, const std::string& description, int 
   } catch (const scene::Error& e) {
     spdlog::error("{}", e.what());
     return 2;
+  } catch (const std::bad_alloc&) {
+    // The readers refuse sizes beyond the machine's memory, counting low; a
+    // run can still outgrow what is free.
+    spdlog::error("out of memory: the run needed more memory than was free (this machine has {:.3g} GB)",
+                  limits::physical_memory() * 1e-9);
+    return 1;
   } catch (const std::exception& e) {
     spdlog::error("{}", e.what());
     return 1;
