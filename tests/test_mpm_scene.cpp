@@ -3,10 +3,12 @@
 // beyond memory and runs that could not finish.
 #include <catch2/catch.hpp>
 
+#include "broken_scenes.hpp"
 #include "common/program.hpp"
 #include "mpm_solid/scene_reader.hpp"
 
 using namespace outburst;
+using testing::replace;
 
 namespace {
 
@@ -46,23 +48,13 @@ material = "coal"
 polygon = [["2 m", "0 m"], ["3 m", "0 m"], ["3 m", "1 m"], ["2 m", "1 m"]]
 )toml";
 
-std::string replace(std::string text, const std::string& from, const std::string& to) {
-  const auto at = text.find(from);
-  REQUIRE(at != std::string::npos);
-  return text.replace(at, from.size(), to);
-}
-
 }  // namespace
 
 TEST_CASE("the reference MPM scene is valid", "[scene][mpm]") { REQUIRE_NOTHROW(read_mpm_scene(valid)); }
 
 TEST_CASE("broken MPM scenes are refused with the key and what is wrong", "[scene][mpm]") {
-  struct Row {
-    std::string scene;
-    std::vector<std::string> message_parts;
-  };
   // Each was accepted before, silently changing the run or hanging it.
-  const std::vector<Row> rows = {
+  const std::vector<testing::BrokenScene> rows = {
       {replace(valid, "box_max = [\"2 m\", \"1 m\"]",
                "box_max = [\"2 m\", \"1 m\"]\n[[mpm.bodies]]\nmaterial = \"coal\"\nbox_min = [\"1.5 m\", \"0.5 m\"]\n"
                "box_max = [\"2.5 m\", \"1 m\"]"),
@@ -90,15 +82,5 @@ TEST_CASE("broken MPM scenes are refused with the key and what is wrong", "[scen
                "[[mpm.bodies]]\nmaterial = \"coal\"\nparticles_per_cell = 4294967298\nbox_min"),
        {"mpm.bodies[0].particles_per_cell", "must be >= 1 and <= 8, got 4294967298"}},
   };
-  for (const auto& row : rows) {
-    INFO(row.scene);
-    try {
-      read_mpm_scene(row.scene);
-      FAIL("the broken scene was accepted");
-    } catch (const scene::Error& e) {
-      const std::string message = e.what();
-      INFO(message);
-      for (const auto& part : row.message_parts) CHECK_THAT(message, Catch::Contains(part));
-    }
-  }
+  testing::check_refused(rows, [](const std::string& scene) { read_mpm_scene(scene); });
 }

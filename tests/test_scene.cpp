@@ -2,10 +2,12 @@
 // expected: a table of broken scenes, each with the message it must produce.
 #include <catch2/catch.hpp>
 
+#include "broken_scenes.hpp"
 #include "common/program.hpp"
 #include "seepage_fe/scene_reader.hpp"
 
 using namespace outburst;
+using testing::replace;
 
 namespace {
 
@@ -38,22 +40,12 @@ type = "pressure"
 value = "0.1 MPa"
 )toml";
 
-std::string replace(std::string text, const std::string& from, const std::string& to) {
-  const auto at = text.find(from);
-  REQUIRE(at != std::string::npos);
-  return text.replace(at, from.size(), to);
-}
-
 }  // namespace
 
 TEST_CASE("the reference scene is valid", "[scene]") { REQUIRE_NOTHROW(read_seepage_scene(valid)); }
 
 TEST_CASE("broken scenes are rejected with file, line, key and what was expected", "[scene]") {
-  struct Row {
-    std::string scene;
-    std::vector<std::string> message_parts;
-  };
-  const std::vector<Row> rows = {
+  const std::vector<testing::BrokenScene> rows = {
       {replace(valid, "time_step = \"1 h\"", "time_stepp = \"1 h\""),
        {"broken.toml", "seepage.time_step", "required key is missing"}},
       {replace(valid, "[seepage]\n", "[seepage]\ncolour = \"red\"\n"),
@@ -123,17 +115,7 @@ TEST_CASE("broken scenes are rejected with file, line, key and what was expected
       {replace(valid, "[seepage.mesh]", "[seepage.mesj]"),
        {"seepage.mesh", "required section [seepage.mesh] is missing", "'seepage.mesj'", "misspelt?"}},
   };
-  for (const auto& row : rows) {
-    INFO(row.scene);
-    try {
-      read_seepage_scene(row.scene);
-      FAIL("the broken scene was accepted");
-    } catch (const scene::Error& e) {
-      const std::string message = e.what();
-      INFO(message);
-      for (const auto& part : row.message_parts) CHECK_THAT(message, Catch::Contains(part));
-    }
-  }
+  testing::check_refused(rows, [](const std::string& scene) { read_seepage_scene(scene); });
 }
 
 TEST_CASE("command-line overrides replace scene keys and are checked like them", "[scene]") {
