@@ -109,11 +109,12 @@ int run(const RunOptions& options, scene::Document& doc) {
                     fmt::format("sub-iterations {}", r.iterations));
     const bool output_due = coupler.time() >= target * (1 - 1e-12);
     at_rest = rest.at_rest(kinetic);
-    if (output_due || at_rest || stop_requested()) {
+    const bool stop = stop_requested();  // read once: a signal may come in between
+    if (output_due || at_rest || stop) {
       snapshot();
       if (output_due) next_output += header.output_interval;
     }
-    if (stop_requested()) {
+    if (stop) {
       progress.finish();
       return report_stop(coupler.time(), directory);
     }

@@ -69,12 +69,13 @@ int run(const RunOptions& options, scene::Document& doc) {
     progress.update(solver.steps(), solver.time(), dt, fmt::format("particles {}", solver.particles().size()));
     const bool output_due = solver.time() >= target * (1 - 1e-12);
     at_rest = rest.active() && rest.at_rest(solver.kinetic_energy());
-    if (output_due || at_rest || stop_requested()) {
+    const bool stop = stop_requested();  // read once: a signal may come in between
+    if (output_due || at_rest || stop) {
       out.snapshot(solver);
       last_snapshot_time = solver.time();
       if (output_due) next_output += header.output_interval;
     }
-    if (stop_requested()) {
+    if (stop) {
       progress.finish();
       return report_stop(solver.time(), out.series().index_path());
     }

@@ -52,9 +52,10 @@ int run(const RunOptions& options, scene::Document& doc) {
     progress.update(solver.steps(), solver.time(), h,
                     fmt::format("iterations {}", report.nonlinear_iterations));
     const bool output_due = solver.time() >= target * (1 - 1e-12);
-    if (output_due || stop_requested()) out.snapshot(solver);
+    const bool stop = stop_requested();  // read once: a signal may come in between
+    if (output_due || stop) out.snapshot(solver);
     if (output_due) next_output += header.output_interval;
-    if (stop_requested()) {
+    if (stop) {
       progress.finish();
       return report_stop(solver.time(), out.series().index_path());
     }
