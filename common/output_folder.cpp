@@ -67,14 +67,18 @@ OutputFolder::OutputFolder(std::filesystem::path directory, const std::string& p
   }
   const std::string earlier = holder(fd);
 
+  std::filesystem::directory_iterator entries(directory_, error);
+  if (error) refuse(directory_, fmt::format("cannot list it: {}", error.message()));
   std::vector<std::filesystem::path> files;
-  for (const auto& entry : std::filesystem::directory_iterator(directory_, error))
+  for (const auto& entry : entries)
     if (written_by_a_run(entry.path().filename().string())) files.push_back(entry.path());
   if (!files.empty() && !overwrite)
     refuse(directory_, fmt::format("it holds the output of an earlier run ({}, {} files); pass --overwrite to "
                                    "replace it, or choose another folder with -o",
                                    earlier.empty() ? "of unknown origin" : earlier, files.size()));
-  for (const auto& f : files) std::filesystem::remove(f, error);
+  for (const auto& f : files)
+    if (!std::filesystem::remove(f, error) && error)
+      refuse(directory_, fmt::format("cannot remove {} of the earlier run: {}", f.filename().string(), error.message()));
   if (!files.empty())
     spdlog::info("removed the {} files of an earlier run ({}) from {}", files.size(),
                  earlier.empty() ? "of unknown origin" : earlier, directory_.string());
