@@ -8,7 +8,8 @@ STUDY.toml names the scene, the program, a measure module and the knobs:
 
     scene = "terzaghi.toml"          # beside STUDY.toml
     program = "outburst"             # seepage-fe, mpm-solid, outburst or a path from here
-                                     # (optional: the one the scene's solvers call for)
+                                     # (optional: the one the scene's solvers call for; one given
+                                     # by path takes SCENE -q -o DIR --overwrite --set KEY=VALUE...)
     measure = "measure.py"           # beside STUDY.toml, see below (optional)
     set = ['scene.end_time="0.3 s"'] # overrides for every run (optional)
     combine = false                  # true: every combination; false: one knob at a time
@@ -221,7 +222,8 @@ REFUSED = 4
 
 def run_one(program, scene, overrides, directory, threads):
     """Runs a program on a scene with overrides; its wall time and, if it failed, its last message."""
-    command = [program, scene, "-q", "-o", directory]
+    # Studies rerun into their folders: the earlier run's files are replaced.
+    command = [program, scene, "-q", "-o", directory, "--overwrite"]
     for o in overrides:
         command += ["--set", o]
     env = dict(os.environ, OMP_NUM_THREADS=str(threads))

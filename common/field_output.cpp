@@ -1,12 +1,10 @@
 #include "common/field_output.hpp"
 
-#include <unistd.h>
-
-#include <fstream>
 #include <stdexcept>
 
 #include <fmt/format.h>
 
+#include "common/atomic_file.hpp"
 #include "common/hdf5_file.hpp"
 
 namespace outburst::output {
@@ -49,18 +47,6 @@ std::string data_item(const std::string& file, const std::string& path, std::siz
 
 }  // namespace
 
-void write_file_atomically(const std::filesystem::path& path, const std::string& text) {
-  std::filesystem::path temp = path;
-  temp += fmt::format(".partial-{}", ::getpid());
-  {
-    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-    out << text;
-    out.flush();
-    if (!out) throw std::runtime_error(fmt::format("cannot write {}", temp.string()));
-  }
-  std::filesystem::rename(temp, path);
-}
-
 void Snapshot::add(const std::string& grid, Field field) {
   fields_[grid].push_back(std::move(field));
 }
@@ -87,7 +73,7 @@ void FieldSeries::add_quad_mesh(const std::string& grid, const std::vector<doubl
 void FieldSeries::add_point_grid(const std::string& grid) { point_grids_.push_back(grid); }
 
 void FieldSeries::write(const Snapshot& snapshot) {
-  const std::string file = fmt::format("{}_{:06d}.h5", name_, written_.size());
+  const std::string file = fmt::format("{}_{:06d}.h5", name_, written_.size() + pending_.size());
   hdf5::H5Writer w(directory_ / file);
   stamp_provenance(w, info_);
   w.attribute("/", "time", snapshot.time());
@@ -113,11 +99,31 @@ void FieldSeries::write(const Snapshot& snapshot) {
     }
   }
   w.commit();
+  if (deferred_) {
+    pending_.push_back(std::move(record));
+    return;
+  }
   written_.push_back(std::move(record));
-  write_index();
+  write_file_atomically(index_path(), index_text());
 }
 
-void FieldSeries::write_index() const {
+void publish(const std::vector<FieldSeries*>& series) {
+  for (auto* s : series) {
+    s->written_.insert(s->written_.end(), s->pending_.begin(), s->pending_.end());
+    s->pending_.clear();
+  }
+  std::vector<std::filesystem::path> temps;
+  try {
+    for (const auto* s : series) temps.push_back(write_beside(s->index_path(), s->index_text()));
+  } catch (...) {
+    std::error_code ignored;
+    for (const auto& t : temps) std::filesystem::remove(t, ignored);
+    throw;
+  }
+  for (std::size_t k = 0; k < series.size(); ++k) move_into_place(temps[k], series[k]->index_path());
+}
+
+std::string FieldSeries::index_text() const {
   std::string x;
   x += "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"3.0\">\n<Domain>\n";
   x += fmt::format("<Information Name=\"program\" Value=\"{} {}\"/>\n", xml_escape(info_.program),
@@ -168,7 +174,7 @@ void FieldSeries::write_index() const {
     if (several) x += "</Grid>\n";
   }
   x += "</Grid>\n</Domain>\n</Xdmf>\n";
-  write_file_atomically(index_path(), x);
+  return x;
 }
 
 }  // namespace outburst::output

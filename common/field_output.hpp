@@ -67,10 +67,19 @@ class FieldSeries {
   // A point cloud whose positions come with each snapshot.
   void add_point_grid(const std::string& grid);
 
+  // Writes the snapshot's file and lists it in the index (or, once
+  // list_with_others() was called, holds it until publish() lists it).
   void write(const Snapshot& snapshot);
 
   std::filesystem::path index_path() const { return directory_ / (name_ + ".xdmf"); }
   std::size_t snapshots_written() const { return written_.size(); }
+
+  // Series written at the same output times (a coupled run's seepage and
+  // particles): from now on a time is listed in their indexes only by
+  // publish(), once every one of them has its snapshot file, so a write that
+  // fails midway (a full disk) leaves all indexes listing the same times.
+  void list_with_others() { deferred_ = true; }
+  friend void publish(const std::vector<FieldSeries*>& series);
 
  private:
   struct MeshGrid {
@@ -91,7 +100,7 @@ class FieldSeries {
     std::map<std::string, WrittenGrid> grids;
   };
 
-  void write_index() const;
+  std::string index_text() const;
 
   std::filesystem::path directory_;
   std::string name_;
@@ -99,9 +108,12 @@ class FieldSeries {
   std::map<std::string, MeshGrid> meshes_;
   std::vector<std::string> point_grids_;
   std::vector<Written> written_;
+  bool deferred_ = false;
+  std::vector<Written> pending_;  // written, not yet listed
 };
 
-// Replace `path` atomically with `text` (temporary file and rename).
-void write_file_atomically(const std::filesystem::path& path, const std::string& text);
+// Lists the snapshots the series hold in their indexes: every index is
+// written under a temporary name before any replaces its predecessor.
+void publish(const std::vector<FieldSeries*>& series);
 
 }  // namespace outburst::output

@@ -1,11 +1,13 @@
 #include "common/hdf5_file.hpp"
 
 #include <hdf5.h>
-#include <unistd.h>
 
 #include <stdexcept>
+#include <utility>
 
 #include <fmt/format.h>
+
+#include "common/atomic_file.hpp"
 
 namespace outburst::hdf5 {
 
@@ -41,6 +43,14 @@ class Handle {
   herr_t (*close_)(hid_t);
 };
 
+// Variable-length UTF-8 strings (h5py reads them as str).
+hid_t string_type() {
+  const hid_t type = H5Tcopy(H5T_C_S1);
+  H5Tset_size(type, H5T_VARIABLE);
+  H5Tset_cset(type, H5T_CSET_UTF8);
+  return type;
+}
+
 void write_dataset(hid_t file, const std::filesystem::path& name, const std::string& path,
                    hid_t file_type, hid_t memory_type, const void* data,
                    const std::vector<std::size_t>& dims) {
@@ -59,18 +69,18 @@ void write_dataset(hid_t file, const std::filesystem::path& name, const std::str
 
 H5Writer::H5Writer(std::filesystem::path final_path) : final_path_(std::move(final_path)) {
   silence_hdf5();
-  temp_path_ = final_path_;
-  temp_path_ += fmt::format(".partial-{}", ::getpid());
-  file_ = H5Fcreate(temp_path_.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
-  if (file_ < 0) fail(temp_path_, "cannot create (is the output folder writable?)");
+  // The file is built in memory and written out in one piece by commit(): a
+  // full disk then fails a plain write. When HDF5 wrote it and its closing
+  // write failed, the library was left half torn down, and closing the file
+  // again (the destructor did, as does HDF5's own cleanup at exit) crashed.
+  Handle access(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
+  H5Pset_fapl_core(access, 1 << 20, false);
+  file_ = H5Fcreate(final_path_.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, access);
+  if (file_ < 0) fail(final_path_, "cannot create it (in memory)");
 }
 
 H5Writer::~H5Writer() {
-  if (file_ >= 0) {
-    H5Fclose(file_);
-    std::error_code ignored;
-    std::filesystem::remove(temp_path_, ignored);
-  }
+  if (file_ >= 0) H5Fclose(file_);
 }
 
 void H5Writer::write(const std::string& path, const double* data,
@@ -88,12 +98,13 @@ void H5Writer::attribute(const std::string& object, const std::string& name,
                          const std::string& value) {
   Handle obj(H5Oopen(file_, object.c_str(), H5P_DEFAULT), H5Oclose);
   if (!obj.valid()) fail(final_path_, fmt::format("no object {} for attribute {}", object, name));
-  Handle type(H5Tcopy(H5T_C_S1), H5Tclose);
-  H5Tset_size(type, std::max<std::size_t>(1, value.size()));
-  H5Tset_strpad(type, H5T_STR_NULLPAD);
+  // Variable length: the text lives in the file's heap, not in the object
+  // header, whose 64 kB limit a fixed-length scene text overran.
+  Handle type(string_type(), H5Tclose);
   Handle space(H5Screate(H5S_SCALAR), H5Sclose);
   Handle attr(H5Acreate2(obj, name.c_str(), type, space, H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
-  if (!attr.valid() || H5Awrite(attr, type, value.empty() ? "" : value.data()) < 0)
+  const char* text = value.c_str();
+  if (!attr.valid() || H5Awrite(attr, type, &text) < 0)
     fail(final_path_, fmt::format("cannot write attribute {} on {}", name, object));
 }
 
@@ -108,9 +119,17 @@ void H5Writer::attribute(const std::string& object, const std::string& name, dou
 }
 
 void H5Writer::commit() {
-  if (H5Fclose(file_) < 0) fail(temp_path_, "cannot close");
-  file_ = -1;
-  std::filesystem::rename(temp_path_, final_path_);
+  const hid_t file = std::exchange(file_, -1);
+  std::string image;
+  const bool flushed = H5Fflush(file, H5F_SCOPE_LOCAL) >= 0;
+  const ssize_t size = flushed ? H5Fget_file_image(file, nullptr, 0) : -1;
+  if (size > 0) {
+    image.resize(static_cast<std::size_t>(size));
+    if (H5Fget_file_image(file, image.data(), image.size()) != size) image.clear();
+  }
+  H5Fclose(file);
+  if (image.empty()) fail(final_path_, "cannot finish it in memory");
+  output::write_file_atomically(final_path_, image);
 }
 
 H5Reader::H5Reader(const std::filesystem::path& path) : path_(path) {
@@ -166,6 +185,16 @@ std::string H5Reader::string_attribute(const std::string& object, const std::str
               H5Aclose);
   if (!attr.valid()) fail(path_, fmt::format("no attribute {} on {}", name, object));
   Handle type(H5Aget_type(attr), H5Tclose);
+  if (H5Tis_variable_str(type) > 0) {
+    Handle memory_type(string_type(), H5Tclose);
+    char* text = nullptr;
+    if (H5Aread(attr, memory_type, &text) < 0 || !text)
+      fail(path_, fmt::format("cannot read attribute {} on {}", name, object));
+    std::string value(text);
+    H5free_memory(text);
+    return value;
+  }
+  // Fixed length, as files of earlier versions hold.
   std::string value(H5Tget_size(type), '\0');
   if (H5Aread(attr, type, value.data()) < 0)
     fail(path_, fmt::format("cannot read attribute {} on {}", name, object));

@@ -1,8 +1,9 @@
 #pragma once
 // Minimal RAII access to HDF5 files for results and checkpoints.
 //
-// Writing is crash-safe: H5Writer writes to a temporary name beside the target
-// and renames it into place only in commit(). A run that dies mid-write leaves the
+// Writing is crash-safe: H5Writer builds the file in memory, and commit()
+// writes it under a temporary name beside the target and renames it into
+// place. A run that dies mid-write, or finds its disk full, leaves the
 // previous complete file (or none), never a truncated one.
 
 #include <cstdint>
@@ -40,7 +41,6 @@ class H5Writer {
 
  private:
   std::filesystem::path final_path_;
-  std::filesystem::path temp_path_;
   std::int64_t file_ = -1;
 };
 

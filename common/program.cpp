@@ -3,6 +3,8 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <charconv>
+#include <new>
 
 #include <CLI/CLI.hpp>
 #include <fmt/ranges.h>
@@ -10,7 +12,9 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
+#include "common/limits.hpp"
 #include "common/progress.hpp"
+#include "common/stop.hpp"
 #include "common/version.hpp"
 
 namespace outburst {
@@ -50,10 +54,14 @@ SceneHeader read_scene_header(const scene::Table& root) {
   }
   const auto o = root.table("output", "what is written and how often", false);
   h.output_interval = h.end_time / 10;
-  if (o && o->has("interval"))
+  if (o && o->has("interval")) {
     h.output_interval = o->quantity({"interval", "simulated time between snapshots (default: end_time / 10)",
                                      "", scene::Range::positive()},
                                     units::time);
+    limits::refuse_count(*o, "interval", h.end_time / h.output_interval, limits::max_snapshots, "snapshots",
+                         fmt::format("end_time {:.3g} s / interval {:.3g} s, a file each; lengthen the interval",
+                                     h.end_time, h.output_interval));
+  }
   return h;
 }
 
@@ -77,6 +85,27 @@ bool finish_reading(const RunOptions& options, const scene::Document& doc) {
   return true;
 }
 
+namespace {
+
+// More threads than this machine has cores only wait on each other, and
+// thousands of them overflow the OpenMP runtime's stacks.
+int most_threads() { return 4 * omp_get_num_procs(); }
+
+CLI::Validator thread_count() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        int n = -1;
+        const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), n);
+        if (ec == std::errc() && end == text.data() + text.size() && n >= 0 && n <= most_threads()) return {};
+        return fmt::format("{} is not a thread count for this machine: give 1 to {} (it has {} hardware threads), or "
+                           "0 for one per hardware thread",
+                           text, most_threads(), omp_get_num_procs());
+      },
+      fmt::format("INT in [0 - {}]", most_threads()));
+}
+
+}  // namespace
+
 int run_program(const std::string& program, const std::string& description, int argc, char** argv,
                 const std::function<int(const RunOptions&, scene::Document&)>& run) {
   CLI::App app(description, program);
@@ -87,13 +116,14 @@ int run_program(const std::string& program, const std::string& description, int 
                  "Override a scene key: dotted.key=<TOML value>, e.g. "
                  "--set seepage.time_step='\"30 min\"'");
   app.add_flag("--check", options.check_only, "Validate the scene and stop");
+  app.add_flag("--overwrite", options.overwrite,
+               "Replace the files of an earlier run in the output folder (otherwise such a folder is refused)");
   app.add_flag("--explain", options.explain,
                "Print every key the scene uses with its value, default and meaning");
   app.add_flag("-q,--quiet", options.quiet, "No progress line");
   app.add_option("--log-level", options.log_level, "trace, debug, info, warn, error")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
-  app.add_option("-j,--threads", options.threads, "OpenMP threads (default: all cores)")
-      ->check(CLI::NonNegativeNumber);
+  app.add_option("-j,--threads", options.threads, "OpenMP threads (default: all cores)")->check(thread_count());
   app.set_version_flag("--version", std::string(version));
   try {
     app.parse(argc, argv);
@@ -105,7 +135,14 @@ int run_program(const std::string& program, const std::string& description, int 
   logger->set_pattern("[%H:%M:%S] [%n] [%^%l%$] %v");
   spdlog::set_default_logger(logger);
   spdlog::set_level(spdlog::level::from_str(options.log_level));
-  if (options.threads > 0) omp_set_num_threads(options.threads);
+  install_stop_handlers();
+  if (options.threads > 0) {
+    omp_set_num_threads(options.threads);
+  } else if (omp_get_max_threads() > most_threads()) {
+    spdlog::warn("OMP_NUM_THREADS asks for {} threads; running {}, one per hardware thread", omp_get_max_threads(),
+                 omp_get_num_procs());
+    omp_set_num_threads(omp_get_num_procs());
+  }
 
   try {
     auto doc = scene::Document::load(options.scene, options.overrides);
@@ -116,6 +153,12 @@ int run_program(const std::string& program, const std::string& description, int 
   } catch (const scene::Error& e) {
     spdlog::error("{}", e.what());
     return 2;
+  } catch (const std::bad_alloc&) {
+    // The readers refuse sizes beyond the machine's memory, counting low; a
+    // run can still outgrow what is free.
+    spdlog::error("out of memory: the run needed more memory than was free (this machine has {:.3g} GB)",
+                  limits::physical_memory() * 1e-9);
+    return 1;
   } catch (const std::exception& e) {
     spdlog::error("{}", e.what());
     return 1;

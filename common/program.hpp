@@ -7,7 +7,8 @@
 // and the one place that turns exceptions into exit codes: 2 for a bad scene or
 // command line (with the file, line and key), 4 for a valid scene refused
 // because what it asks for cannot work in its regime (scene::Refusal: a
-// coupling scheme predicted unstable), 1 for a run that failed.
+// coupling scheme predicted unstable), 1 for a run that failed. A run
+// stopped by SIGINT or SIGTERM ends with exit_stopped, 3 (common/stop.hpp).
 
 #include <algorithm>
 #include <filesystem>
@@ -26,6 +27,7 @@ struct RunOptions {
   std::filesystem::path output;  // empty: results/<scene name>
   std::vector<std::string> overrides;
   bool check_only = false;   // read and validate the scene, run nothing
+  bool overwrite = false;    // replace an earlier run's files in the output folder
   bool explain = false;      // print every key the scene uses, with defaults
   bool quiet = false;        // no progress line
   std::string log_level = "info";

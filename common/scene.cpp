@@ -5,6 +5,8 @@
 #include <functional>
 #include <cmath>
 #include <fstream>
+#include <limits>
+#include <numbers>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -15,6 +17,9 @@ namespace outburst::scene {
 namespace {
 
 std::string read_text(const std::filesystem::path& file) {
+  // A device (/dev/zero) or a pipe would be read without end.
+  if (const auto what = not_a_regular_file(file))
+    throw Error(fmt::format("{}: the scene is {}; expected a TOML file", file.string(), *what));
   std::ifstream in(file, std::ios::binary);
   if (!in) throw Error(fmt::format("{}: cannot open the scene file", file.string()));
   std::ostringstream s;
@@ -51,6 +56,70 @@ double parse_number_text(std::string_view text) {
   return v;
 }
 
+// "a pressure", "an angle".
+std::string with_article(const std::string& noun) {
+  const bool vowel = !noun.empty() && std::string_view("aeiou").find(noun.front()) != std::string_view::npos;
+  return (vowel ? "an " : "a ") + noun;
+}
+
+// ", such as \"3 s\"" (or an array of `count` of them), in the dimension's
+// unit; empty for a dimension no single unit has.
+std::string example(double value, const units::Dimension& dimension, std::size_t count = 0) {
+  const std::string unit = units::symbol(dimension);
+  if (unit.empty()) return {};
+  if (count == 0) return fmt::format(", such as \"{:g} {}\"", value, unit);
+  std::string items;
+  for (std::size_t k = 0; k < count; ++k) items += fmt::format("{}\"{:g} {}\"", k ? ", " : "", value + k, unit);
+  return ", such as [" + items + "]";
+}
+
+// Angle keys are written in degrees, so their ranges are shown in degrees;
+// the others in SI.
+std::string range_text(const Range& range, const units::Dimension& dimension) {
+  if (dimension == units::angle) return range.describe(std::numbers::pi / 180, "deg");
+  return range.describe() + " (in SI)";
+}
+
+// The key's range narrowed to the values T holds.
+template <std::integral T>
+Range within_type(Range range) {
+  const double lowest = static_cast<double>(std::numeric_limits<T>::min());
+  const double highest = static_cast<double>(std::numeric_limits<T>::max());
+  if (!range.min || *range.min < lowest) range.min = lowest, range.min_inclusive = true;
+  if (!range.max || *range.max > highest) range.max = highest, range.max_inclusive = true;
+  return range;
+}
+
+// Edits (insertions, deletions, substitutions, swaps of neighbours) that turn a into b.
+std::size_t edit_distance(std::string_view a, std::string_view b) {
+  std::vector<std::vector<std::size_t>> d(a.size() + 1, std::vector<std::size_t>(b.size() + 1));
+  for (std::size_t i = 0; i <= a.size(); ++i) d[i][0] = i;
+  for (std::size_t j = 0; j <= b.size(); ++j) d[0][j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i)
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + (a[i - 1] != b[j - 1])});
+      if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1])
+        d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
+    }
+  return d[a.size()][b.size()];
+}
+
+// "bodies" -> "body", "regions" -> "region".
+std::string singular(std::string_view word) {
+  if (word.ends_with("ies")) return std::string(word.substr(0, word.size() - 3)) + "y";
+  if (word.ends_with("s")) return std::string(word.substr(0, word.size() - 1));
+  return std::string(word);
+}
+
+// One slip of the keyboard (two in a long name), a plural for a singular or
+// the other way round, or a few letters too many ("scenery"); short names
+// differ too little to tell a slip from another key.
+bool looks_misspelt(std::string_view written, std::string_view meant) {
+  if (written == meant || meant.size() < 4) return false;
+  return edit_distance(written, meant) <= (std::min(written.size(), meant.size()) >= 10 ? 2 : 1) ||
+         singular(written) == singular(meant) || (written.starts_with(meant) && written.size() <= meant.size() + 3);
+}
+
 std::string join(const std::vector<std::string_view>& words) {
   std::string s;
   for (const auto& w : words) s += fmt::format("{}\"{}\"", s.empty() ? "" : ", ", w);
@@ -85,7 +154,10 @@ void apply_override(toml::table& root, const std::string& assignment) {
       if (digits.empty() || digits.find_first_not_of("0123456789") != std::string::npos)
         throw Error(fmt::format("--set '{}': '{}' is not an index; write {}[0]", assignment, digits,
                                 key.substr(0, open)));
-      index = std::stoul(digits);
+      std::size_t value = 0;
+      if (std::from_chars(digits.data(), digits.data() + digits.size(), value).ec != std::errc())
+        throw Error(fmt::format("--set '{}': the scene has no table {}", assignment, key));
+      index = value;
       key.resize(open);
     }
     if (dot == std::string_view::npos && !index) {
@@ -121,13 +193,34 @@ bool Range::contains(double v) const {
   return true;
 }
 
-std::string Range::describe() const {
-  if (min && max)
-    return fmt::format("{} {:g} and {} {:g}", min_inclusive ? ">=" : ">", *min,
-                       max_inclusive ? "<=" : "<", *max);
-  if (min) return fmt::format("{} {:g}", min_inclusive ? ">=" : ">", *min);
-  if (max) return fmt::format("{} {:g}", max_inclusive ? "<=" : "<", *max);
+std::string Range::describe(double scale, std::string_view unit) const {
+  const auto limit = [&](bool inclusive, bool lower, double v) {
+    const double shown = v / scale;
+    // Integer limits in full (2147483647, not 2.14748e+09).
+    const std::string number =
+        shown == std::round(shown) && std::abs(shown) < 1e15 ? fmt::format("{:.0f}", shown) : fmt::format("{:g}", shown);
+    return fmt::format("{} {}{}{}", lower ? (inclusive ? ">=" : ">") : (inclusive ? "<=" : "<"), number,
+                       unit.empty() ? "" : " ", unit);
+  };
+  if (min && max) return limit(min_inclusive, true, *min) + " and " + limit(max_inclusive, false, *max);
+  if (min) return limit(min_inclusive, true, *min);
+  if (max) return limit(max_inclusive, false, *max);
   return "finite";
+}
+
+std::optional<std::string> not_a_regular_file(const std::filesystem::path& path) {
+  std::error_code error;
+  const auto status = std::filesystem::status(path, error);
+  switch (status.type()) {
+    case std::filesystem::file_type::regular: return std::nullopt;
+    case std::filesystem::file_type::directory: return "a directory";
+    case std::filesystem::file_type::character:
+    case std::filesystem::file_type::block: return "a device";
+    case std::filesystem::file_type::fifo: return "a pipe";
+    case std::filesystem::file_type::socket: return "a socket";
+    case std::filesystem::file_type::not_found: return "missing";
+    default: return "not a regular file";
+  }
 }
 
 // ---------------------------------------------------------------- Document
@@ -177,6 +270,36 @@ std::string Document::located(const toml::node* n, const std::string& key_path,
     where = fmt::format("{}:{}:{}", file_.string(), n->source().begin.line, n->source().begin.column);
   if (key_path.empty()) return fmt::format("{}: {}", where, message);
   return fmt::format("{}: key '{}': {}", where, key_path, message);
+}
+
+std::string Document::misspelling_hint(const std::string& key_path) const {
+  // Along the path, each table's unread keys against the name wanted there:
+  // a misspelt key is a sibling of the missing one or of a table above it.
+  std::vector<std::string> suspects;
+  const toml::table* table = root_.get();
+  std::string at;
+  for (std::string_view rest = key_path; table && !rest.empty();) {
+    const auto dot = rest.find('.');
+    const std::string_view part = rest.substr(0, dot);
+    const std::string name(part.substr(0, part.find('[')));
+    for (const auto& [k, v] : *table)
+      if (!used_.count(&v) && looks_misspelt(k.str(), name))
+        suspects.push_back(fmt::format("'{}{}' ({}:{}:{})", at, k.str(), file_.string(), v.source().begin.line,
+                                       v.source().begin.column));
+    const toml::node* next = table->get(name);
+    if (next && part.find('[') != std::string_view::npos) {
+      std::size_t index = 0;
+      std::from_chars(part.data() + part.find('[') + 1, part.data() + part.size(), index);
+      next = next->is_array() ? next->as_array()->get(index) : nullptr;
+    }
+    table = next ? next->as_table() : nullptr;
+    at += std::string(part) + ".";
+    rest = dot == std::string_view::npos ? std::string_view() : rest.substr(dot + 1);
+  }
+  if (suspects.empty()) return {};
+  std::string list;
+  for (const auto& s : suspects) list += (list.empty() ? "" : ", ") + s;
+  return fmt::format("; the scene has {}, which nothing reads: misspelt?", list);
 }
 
 void Document::check_unused(const toml::table& table, const std::string& path) const {
@@ -234,7 +357,8 @@ const toml::node* Table::node(std::string_view key) const {
 
 void Table::fail(std::string_view key, const std::string& message) const {
   const toml::node* n = table_->get(key);
-  throw Error(doc_->located(n ? n : table_, key_path(key), message));
+  if (n) throw Error(doc_->located(n, key_path(key), message));
+  throw Error(doc_->located(table_, key_path(key), message + doc_->misspelling_hint(key_path(key))));
 }
 
 void Table::refuse(std::string_view key, const std::string& message) const {
@@ -244,9 +368,7 @@ void Table::refuse(std::string_view key, const std::string& message) const {
 
 const toml::node* Table::required_node(const Key& key) const {
   const toml::node* n = node(key.name);
-  if (!n && key.fallback.empty())
-    throw Error(doc_->located(table_, key_path(key.name),
-                              fmt::format("required key is missing ({})", key.doc)));
+  if (!n && key.fallback.empty()) fail(key.name, fmt::format("required key is missing ({})", key.doc));
   return n;
 }
 
@@ -262,14 +384,14 @@ units::Quantity quantity_from_text(std::string_view text, const units::Dimension
   try {
     q = units::parse_quantity(text);
   } catch (const units::UnitError& e) {
-    fail(fmt::format("expected a {} with its unit: {}", units::describe(dimension), e.what()));
+    fail(fmt::format("expected {} with its unit: {}", with_article(units::describe(dimension)), e.what()));
   }
   if (!(q.dimension == dimension)) {
     const std::string given = q.dimension == units::dimensionless
                                   ? std::string("a bare number")
-                                  : "a " + units::describe(q.dimension);
-    fail(fmt::format("expected a {} with its unit, got \"{}\", which is {}",
-                     units::describe(dimension), text, given));
+                                  : with_article(units::describe(q.dimension));
+    fail(fmt::format("expected {} with its unit, got \"{}\", which is {}",
+                     with_article(units::describe(dimension)), text, given));
   }
   return q;
 }
@@ -284,17 +406,15 @@ std::pair<double, units::Dimension> Table::quantity_of(const Key& key,
                                                        const units::Dimension& a,
                                                        const units::Dimension& b) const {
   const toml::node* n = required_node(key);
-  const std::string expected =
-      a == b ? units::describe(a)
-             : fmt::format("{} or a {}", units::describe(a), units::describe(b));
+  const std::string expected = a == b ? with_article(units::describe(a))
+                                      : with_article(units::describe(a)) + " or " + with_article(units::describe(b));
   std::string text;
   if (n) {
     if (!n->is_string()) {
       if (n->is_number())
-        fail(key.name, fmt::format("expected a {} with its unit as a string, such as \"{}\"; "
-                                   "a bare number has no unit",
-                                   expected, key.fallback.empty() ? "1 m" : key.fallback));
-      fail(key.name, fmt::format("expected a {} with its unit as a string", expected));
+        fail(key.name, fmt::format("expected {} with its unit as a string{}; a bare number has no unit", expected,
+                                   example(n->value<double>().value_or(1), a)));
+      fail(key.name, fmt::format("expected {} with its unit as a string", expected));
     }
     text = n->as_string()->get();
   } else {
@@ -304,17 +424,17 @@ std::pair<double, units::Dimension> Table::quantity_of(const Key& key,
   try {
     q = units::parse_quantity(text);
   } catch (const units::UnitError& e) {
-    fail(key.name, fmt::format("expected a {} with its unit: {}", expected, e.what()));
+    fail(key.name, fmt::format("expected {} with its unit: {}", expected, e.what()));
   }
   if (!(q.dimension == a) && !(q.dimension == b)) {
     const std::string given = q.dimension == units::dimensionless
                                   ? std::string("a bare number")
-                                  : "a " + units::describe(q.dimension);
-    fail(key.name, fmt::format("expected a {} with its unit, got \"{}\", which is {}", expected,
+                                  : with_article(units::describe(q.dimension));
+    fail(key.name, fmt::format("expected {} with its unit, got \"{}\", which is {}", expected,
                                text, given));
   }
   if (!key.range.contains(q.si))
-    fail(key.name, fmt::format("must be {} (in SI), got \"{}\"", key.range.describe(), text));
+    fail(key.name, fmt::format("must be {}, got \"{}\"", range_text(key.range, q.dimension), text));
   record(key, text, n == nullptr);
   return {q.si, q.dimension};
 }
@@ -326,13 +446,12 @@ std::vector<double> Table::quantity_vector(const Key& key, const units::Dimensio
   if (n) {
     const auto* arr = n->as_array();
     if (!arr || arr->size() != count)
-      fail(key.name, fmt::format("expected an array of {} {} values with units, such as "
-                                 "[\"0 m\", \"1 m\"]",
-                                 count, units::describe(dimension)));
+      fail(key.name, fmt::format("expected an array of {} {} values with units{}", count, units::describe(dimension),
+                                 example(0, dimension, count)));
     for (const auto& item : *arr) {
       if (!item.is_string())
-        fail(key.name, fmt::format("expected each entry as a {} with its unit, as a string",
-                                   units::describe(dimension)));
+        fail(key.name, fmt::format("expected each entry as {} with its unit, as a string",
+                                   with_article(units::describe(dimension))));
       texts.push_back(item.as_string()->get());
     }
   } else {
@@ -343,7 +462,7 @@ std::vector<double> Table::quantity_vector(const Key& key, const units::Dimensio
   for (const auto& t : texts) {
     const auto q = quantity_from_text(t, dimension, [&](const std::string& m) { fail(key.name, m); });
     if (!key.range.contains(q.si))
-      fail(key.name, fmt::format("each entry must be {} (in SI), got \"{}\"", key.range.describe(), t));
+      fail(key.name, fmt::format("each entry must be {}, got \"{}\"", range_text(key.range, dimension), t));
     values.push_back(q.si);
     shown += fmt::format("{}\"{}\"", shown.empty() ? "" : ", ", t);
   }
@@ -354,9 +473,9 @@ std::vector<double> Table::quantity_vector(const Key& key, const units::Dimensio
 std::vector<std::array<double, 2>> Table::quantity_points(const Key& key,
                                                          const units::Dimension& dimension) const {
   const toml::node* n = required_node(key);
-  const std::string form = fmt::format("expected an array of points [[\"x\", \"y\"], ...], each coordinate a {} "
+  const std::string form = fmt::format("expected an array of points [[\"x\", \"y\"], ...], each coordinate {} "
                                        "with its unit",
-                                       units::describe(dimension));
+                                       with_article(units::describe(dimension)));
   const auto* arr = n ? n->as_array() : nullptr;
   if (!arr) fail(key.name, form);
   std::vector<std::array<double, 2>> points;
@@ -391,45 +510,52 @@ double Table::number(const Key& key) const {
   return v;
 }
 
-long Table::integer(const Key& key) const {
+template <std::integral T>
+T Table::integer(const Key& key) const {
   const toml::node* n = required_node(key);
-  long v = 0;
+  std::int64_t v = 0;
   if (n) {
     if (!n->is_integer()) fail(key.name, fmt::format("expected an integer, got {}", node_text(*n)));
-    v = static_cast<long>(n->as_integer()->get());
+    v = n->as_integer()->get();
   } else {
-    v = static_cast<long>(parse_number_text(key.fallback));
+    v = static_cast<std::int64_t>(parse_number_text(key.fallback));
   }
-  if (!key.range.contains(static_cast<double>(v)))
-    fail(key.name, fmt::format("must be {}, got {}", key.range.describe(), v));
+  const Range range = within_type<T>(key.range);
+  if (!range.contains(static_cast<double>(v))) fail(key.name, fmt::format("must be {}, got {}", range.describe(), v));
   record(key, std::to_string(v), n == nullptr);
-  return v;
+  return static_cast<T>(v);
 }
 
-std::vector<long> Table::integer_vector(const Key& key, std::size_t count) const {
+template <std::integral T>
+std::vector<T> Table::integer_vector(const Key& key, std::size_t count) const {
   const toml::node* n = required_node(key);
-  std::vector<long> values;
+  std::vector<std::int64_t> values;
   if (n) {
     const auto* arr = n->as_array();
     if (!arr || arr->size() != count)
       fail(key.name, fmt::format("expected an array of {} integers", count));
     for (const auto& item : *arr) {
       if (!item.is_integer()) fail(key.name, fmt::format("expected an array of {} integers", count));
-      values.push_back(static_cast<long>(item.as_integer()->get()));
+      values.push_back(item.as_integer()->get());
     }
   } else {
     for (auto part : split_commas(key.fallback))
-      values.push_back(static_cast<long>(parse_number_text(part)));
+      values.push_back(static_cast<std::int64_t>(parse_number_text(part)));
   }
+  const Range range = within_type<T>(key.range);
   std::string shown;
-  for (long v : values) {
-    if (!key.range.contains(static_cast<double>(v)))
-      fail(key.name, fmt::format("each entry must be {}, got {}", key.range.describe(), v));
+  for (const std::int64_t v : values) {
+    if (!range.contains(static_cast<double>(v)))
+      fail(key.name, fmt::format("each entry must be {}, got {}", range.describe(), v));
     shown += fmt::format("{}{}", shown.empty() ? "" : ", ", v);
   }
   record(key, "[" + shown + "]", n == nullptr);
-  return values;
+  return {values.begin(), values.end()};
 }
+
+// The programs store their integer keys as int.
+template int Table::integer<int>(const Key&) const;
+template std::vector<int> Table::integer_vector<int>(const Key&, std::size_t) const;
 
 std::vector<double> Table::number_vector(const Key& key, std::size_t count) const {
   const toml::node* n = required_node(key);
@@ -524,8 +650,10 @@ std::filesystem::path Table::file(const Key& key) const {
   const std::string text = string(key);
   std::filesystem::path p(text);
   if (p.is_relative()) p = doc_->file().parent_path() / p;
-  if (!std::filesystem::exists(p))
-    fail(key.name, fmt::format("the file \"{}\" does not exist (looked for {})", text, p.string()));
+  if (const auto what = not_a_regular_file(p))
+    fail(key.name, *what == "missing"
+                       ? fmt::format("the file \"{}\" does not exist (looked for {})", text, p.string())
+                       : fmt::format("\"{}\" is {} (looked at {}); expected a file", text, *what, p.string()));
   return p;
 }
 
@@ -535,9 +663,9 @@ TimeFunction Table::time_function(const Key& key, const units::Dimension& dimens
   node(key.name);
   const auto* arr = n->as_array();
   const std::string form = fmt::format(
-      "expected a {} with its unit (\"0.1 MPa\") or a table of [time, value] pairs "
+      "expected {} with its unit (\"0.1 MPa\") or a table of [time, value] pairs "
       "([[\"0 s\", \"3 MPa\"], [\"10 s\", \"0.1 MPa\"]])",
-      units::describe(dimension));
+      with_article(units::describe(dimension)));
   if (!arr || arr->empty()) fail(key.name, form);
   std::vector<std::pair<double, double>> points;
   for (const auto& item : *arr) {
@@ -551,7 +679,7 @@ TimeFunction Table::time_function(const Key& key, const units::Dimension& dimens
     if (!points.empty() && t <= points.back().first)
       fail(key.name, "the times of the [time, value] pairs must increase strictly");
     if (!key.range.contains(v))
-      fail(key.name, fmt::format("every value must be {} (in SI), got \"{}\"", key.range.describe(),
+      fail(key.name, fmt::format("every value must be {}, got \"{}\"", range_text(key.range, dimension),
                                  pair->get(1)->as_string()->get()));
     points.emplace_back(t, v);
   }
@@ -562,9 +690,7 @@ TimeFunction Table::time_function(const Key& key, const units::Dimension& dimens
 std::optional<Table> Table::table(std::string_view key, std::string_view doc, bool required) const {
   const toml::node* n = node(key);
   if (!n) {
-    if (required)
-      throw Error(doc_->located(table_, key_path(key),
-                                fmt::format("required section [{}] is missing ({})", key_path(key), doc)));
+    if (required) fail(key, fmt::format("required section [{}] is missing ({})", key_path(key), doc));
     return std::nullopt;
   }
   if (!n->is_table()) fail(key, fmt::format("expected a section (a TOML table): {}", doc));

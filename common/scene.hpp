@@ -9,6 +9,7 @@
 // Errors name the file, line, column and dotted key path, and what was expected.
 
 #include <array>
+#include <concepts>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -54,9 +55,14 @@ struct Range {
   static Range non_negative() { return {0.0, std::nullopt, true, true}; }
   static Range at_least(double v) { return {v, std::nullopt, true, true}; }
   static Range between(double lo, double hi) { return {lo, hi, true, true}; }
-  std::string describe() const;
+  // Limits are shown divided by `scale`, followed by `unit` ("30 deg").
+  std::string describe(double scale = 1, std::string_view unit = {}) const;
   bool contains(double v) const;
 };
+
+// Why `path` cannot be read as a file ("a directory", "a device", "a pipe",
+// "missing"); nullopt for a regular file.
+std::optional<std::string> not_a_regular_file(const std::filesystem::path& path);
 
 // One key a scene may hold. `fallback` is the default as it would be written in
 // the scene (for example "1 h"); empty means the key is required.
@@ -96,8 +102,12 @@ class Table {
   // An array of points, each a pair of quantities: [["0 m", "1 m"], ...].
   std::vector<std::array<double, 2>> quantity_points(const Key& key, const units::Dimension& dimension) const;
   double number(const Key& key) const;
-  long integer(const Key& key) const;
-  std::vector<long> integer_vector(const Key& key, std::size_t count) const;
+  // An integer checked against the key's range and the range of T (the type
+  // the program stores it in), so no value wraps when it is stored.
+  template <std::integral T>
+  T integer(const Key& key) const;
+  template <std::integral T>
+  std::vector<T> integer_vector(const Key& key, std::size_t count) const;
   std::vector<double> number_vector(const Key& key, std::size_t count) const;
   bool boolean(const Key& key) const;
   std::string string(const Key& key) const;
@@ -156,6 +166,10 @@ class Document {
   // Error message with location: "file:line:col: key 'a.b': message".
   std::string located(const toml::node* node, const std::string& key_path,
                       const std::string& message) const;
+  // For a missing key: keys nothing has read whose names are one or two
+  // letters off a part of `key_path` (a misspelt "[couplings]" leaves
+  // "coupling.window" missing). Empty when there is none.
+  std::string misspelling_hint(const std::string& key_path) const;
 
  private:
   friend class Table;

@@ -49,8 +49,8 @@ constexpr std::array<NamedUnit, 33> known_units{{
     {"kJ", 1e3, {2, 1, -2, 0}},
     {"MJ", 1e6, {2, 1, -2, 0}},
     {"W", 1.0, {2, 1, -3, 0}},
-    {"rad", 1.0, angle},
     {"deg", pi / 180.0, angle},
+    {"rad", 1.0, angle},
     {"L", 1e-3, {3, 0, 0, 0}},
     {"Hz", 1.0, {0, 0, -1, 0}},
     {"mPa", 1e-3, pressure},
@@ -62,7 +62,7 @@ struct NamedDimension {
   Dimension dimension;
 };
 
-const std::array<NamedDimension, 19> named_dimensions{{
+const std::array<NamedDimension, 20> named_dimensions{{
     {"dimensionless number", dimensionless},
     {"length", length},
     {"mass", mass},
@@ -81,6 +81,7 @@ const std::array<NamedDimension, 19> named_dimensions{{
     {"gas content coefficient per mass (volume / (mass pressure^1/2))",
      gas_content_per_mass},
     {"force per length", {0, 1, -2, 0}},
+    {"force", {1, 1, -2, 0}},
     {"frequency", {0, 0, -1, 0}},
     {"energy", {2, 1, -2, 0}},
 }};
@@ -166,28 +167,40 @@ class UnitParser {
       base = lookup(symbol);
     }
     const double exponent = optional_exponent();
-    return {std::pow(base.si, exponent), base.dimension.pow(exponent)};
+    const double si = std::pow(base.si, exponent);
+    if (!std::isfinite(si) || si == 0)
+      fail(fmt::format("the power ^{:g} takes the unit beyond the range of numbers (about 1e-308 to 1e308)", exponent));
+    return {si, base.dimension.pow(exponent)};
   }
 
   double optional_exponent() {
     if (pos_ < text_.size() && text_[pos_] == '^') {
       ++pos_;
-      return number("an exponent after '^'");
+      return number("an exponent after '^'", true);
     }
     if (pos_ < text_.size() &&
         (std::isdigit(static_cast<unsigned char>(text_[pos_])) || text_[pos_] == '-'))
-      return number("an exponent");
+      return number("an exponent", false);
     return 1.0;
   }
 
-  double number(const char* what) {
+  // After '^' an exponent may be written in scientific notation ("^1e-1"); a
+  // bare one ("m2") may not, or "m2e" would swallow the start of a unit.
+  double number(const char* what, bool scientific) {
     const std::size_t start = pos_;
+    const auto digit_or_sign = [&](std::size_t at) {
+      return at < text_.size() && (std::isdigit(static_cast<unsigned char>(text_[at])) || text_[at] == '-' ||
+                                   text_[at] == '+');
+    };
     while (pos_ < text_.size() &&
            (std::isdigit(static_cast<unsigned char>(text_[pos_])) || text_[pos_] == '.' ||
-            text_[pos_] == '-' || text_[pos_] == '+'))
+            text_[pos_] == '-' || text_[pos_] == '+' ||
+            (scientific && pos_ > start && (text_[pos_] == 'e' || text_[pos_] == 'E') && digit_or_sign(pos_ + 1))))
       ++pos_;
     double value = 0;
     const auto [end, ec] = std::from_chars(text_.data() + start, text_.data() + pos_, value);
+    if (ec == std::errc::result_out_of_range)
+      fail(fmt::format("{} is out of range", text_.substr(start, pos_ - start)));
     if (ec != std::errc() || end != text_.data() + pos_ || start == pos_)
       fail(fmt::format("expected {}", what));
     return value;
@@ -235,6 +248,12 @@ std::string describe(const Dimension& d) {
   return formula;
 }
 
+std::string symbol(const Dimension& d) {
+  for (const auto& u : known_units)
+    if (u.dimension == d) return std::string(u.symbol);
+  return {};
+}
+
 Quantity parse_unit(std::string_view unit_expression) {
   return UnitParser(unit_expression).parse();
 }
@@ -246,6 +265,8 @@ Quantity parse_quantity(std::string_view text) {
   const char* first = text.data() + start;
   const char* last = text.data() + text.size();
   auto [end, ec] = std::from_chars(first, last, value);
+  if (ec == std::errc::result_out_of_range)
+    throw UnitError(fmt::format("the number in \"{}\" is beyond the range of numbers (about 1e-308 to 1e308)", text));
   if (ec != std::errc() || end == first)
     throw UnitError(fmt::format("\"{}\" does not start with a number", text));
   std::string_view rest(end, static_cast<std::size_t>(last - end));
@@ -253,7 +274,12 @@ Quantity parse_quantity(std::string_view text) {
   while (!rest.empty() && rest.back() == ' ') rest.remove_suffix(1);
   if (rest.empty()) return {value, dimensionless};
   const Quantity unit = parse_unit(rest);
-  return {value * unit.si, unit.dimension};
+  const double si = value * unit.si;
+  if (!std::isfinite(si))
+    throw UnitError(fmt::format("\"{}\" overflows: in SI it exceeds the largest number (about 1.8e308)", text));
+  if (si == 0 && value != 0)
+    throw UnitError(fmt::format("\"{}\" underflows: in SI it is below the smallest number (about 1e-308)", text));
+  return {si, unit.dimension};
 }
 
 }  // namespace outburst::units

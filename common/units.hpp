@@ -49,6 +49,9 @@ inline constexpr Dimension gas_content_per_mass{3.5, -1.5, 1, 0};
 
 // A readable name ("pressure") or the exponent formula ("m^2 kg^-1 s^3").
 std::string describe(const Dimension& d);
+// A unit of that dimension scenes write ("Pa", "deg"); empty when none of
+// the known units has it alone.
+std::string symbol(const Dimension& d);
 
 struct Quantity {
   double si;  // value converted to SI

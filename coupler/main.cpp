@@ -2,11 +2,15 @@
 // solver run as partners of a coupling (coupler/coupling.hpp) window by window.
 #include <chrono>
 #include <fstream>
+#include <stdexcept>
 
 #include <spdlog/spdlog.h>
 
+#include "common/limits.hpp"
+#include "common/output_folder.hpp"
 #include "common/program.hpp"
 #include "common/progress.hpp"
+#include "common/stop.hpp"
 #include "coupler/model.hpp"
 #include "mpm_solid/output.hpp"
 #include "seepage_fe/output.hpp"
@@ -35,6 +39,7 @@ class WindowLog {
       out_ << (k < r.residuals.size() ? fmt::format(",{:.3e}", r.residuals[k]) : std::string(","));
     out_ << '\n';
     out_.flush();
+    if (!out_) throw std::runtime_error("cannot write coupling.csv: the disk may be full");
   }
 
  private:
@@ -42,9 +47,21 @@ class WindowLog {
   std::size_t fields_;
 };
 
+// Refuses a run of more windows or MPM steps than any run may take.
+void check_run_length(scene::Table root, const coupling::CoupledSetup& setup) {
+  const double end_time = setup.header.end_time, window = setup.coupling.window;
+  limits::refuse_count(*root.table("coupling", "", true), "window", end_time / window, limits::max_steps,
+                       "coupling windows",
+                       fmt::format("end_time {:.3g} s / window {:.3g} s; lengthen the window", end_time, window));
+  mpm::check_run_length(*root.table("mpm", "", true), setup.solid, end_time);
+}
+
 int run(const RunOptions& options, scene::Document& doc) {
   coupling::CoupledSetup setup = coupling::read_coupled_setup(doc.root());
+  doc.reject_unused();
+  check_run_length(doc.root(), setup);
   if (!finish_reading(options, doc)) return 0;
+  const OutputFolder folder(options.output_directory(), "outburst", options.overwrite);
   const SceneHeader header = setup.header;
   const auto tracers = setup.solid.tracers;
   coupling::CoupledModel model(std::move(setup));
@@ -57,14 +74,20 @@ int run(const RunOptions& options, scene::Document& doc) {
   spdlog::info("{}: {} seepage cells, {} particles, window {:.3g} s", header.title, model.mapping().mesh().num_cells(),
                solid.particles().size(), cs.window);
 
-  const auto directory = options.output_directory();
+  const auto& directory = folder.path();
   const auto info = run_info("outburst", doc, "SI: m, s, kg, Pa; 2D plane strain, per metre of depth; MPM stresses "
                                               "are effective (total = effective - alpha p I)");
   seepage::Output seepage_out(directory, info, seepage_solver);
   mpm::Output solid_out(directory, info, tracers);
   WindowLog log(directory / "coupling.csv", cs.scheme.to_first);
-  seepage_out.snapshot(seepage_solver);
-  solid_out.snapshot(solid);
+  seepage_out.series().list_with_others();
+  solid_out.series().list_with_others();
+  const auto snapshot = [&] {
+    seepage_out.snapshot(seepage_solver);
+    solid_out.snapshot(solid);
+    output::publish({&seepage_out.series(), &solid_out.series()});
+  };
+  snapshot();
 
   const auto wall_start = std::chrono::steady_clock::now();
   Progress progress("outburst", 0.0, header.end_time, options.show_progress());
@@ -86,10 +109,14 @@ int run(const RunOptions& options, scene::Document& doc) {
                     fmt::format("sub-iterations {}", r.iterations));
     const bool output_due = coupler.time() >= target * (1 - 1e-12);
     at_rest = rest.at_rest(kinetic);
-    if (output_due || at_rest) {
-      seepage_out.snapshot(seepage_solver);
-      solid_out.snapshot(solid);
+    const bool stop = stop_requested();  // read once: a signal may come in between
+    if (output_due || at_rest || stop) {
+      snapshot();
       if (output_due) next_output += header.output_interval;
+    }
+    if (stop) {
+      progress.finish();
+      return report_stop(coupler.time(), directory);
     }
     if (at_rest) break;
   }

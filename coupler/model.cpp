@@ -143,6 +143,17 @@ CoupledSetup read_coupled_scene(scene::Table root) {
   if (s.coupling.gas_solid.biot_storage && s.seepage.model.law != seepage::Law::linear)
     coupling->fail("biot_storage", "the Biot storage term is written for the linear Darcy law: set seepage.law = "
                                    "\"linear\" or drop the key");
+  // Seepage cells off the MPM grid never hold coal: they would read as open
+  // space and release their gas at once.
+  Eigen::Vector2d lo = s.seepage.mesh.nodes.front(), hi = lo;
+  for (const auto& x : s.seepage.mesh.nodes) lo = lo.cwiseMin(x), hi = hi.cwiseMax(x);
+  if (const auto past = mpm::overhang(s.solid.grid, lo, hi); !past.empty()) {
+    const auto mesh = root.table("seepage", "", true)->table("mesh", "", true);
+    mesh->fail(mesh->has("file") ? "file" : "origin",
+               fmt::format("the seepage mesh, [{:g}, {:g}] x [{:g}, {:g}] m, reaches {}: its cells there hold no coal "
+                           "and would read as open space",
+                           lo.x(), hi.x(), lo.y(), hi.y(), past));
+  }
   // Every seepage cell the coal fills must read as coal: one without a
   // particle, or with fewer than open_below of its area in particles, reads as
   // open space and misses the coal's volume change (measured: Mandel's

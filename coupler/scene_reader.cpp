@@ -98,16 +98,16 @@ CouplingSetup read_coupling(const scene::Table& c) {
   a.relaxation = c.number({"relaxation", "constant: the factor; Aitken and IQN-ILS: that of a window's first "
                                          "iteration",
                            text(acceleration_default.relaxation), Range{0.0, 1.0, false, true}});
-  a.reuse_windows = static_cast<int>(c.integer({"reuse_windows", "past windows whose secant columns IQN-ILS reuses",
-                                                text(acceleration_default.reuse_windows), Range::between(0, 100)}));
-  a.max_columns = static_cast<int>(c.integer({"max_columns", "most secant columns of IQN-ILS",
-                                              text(acceleration_default.max_columns), Range::between(1, 10000)}));
+  a.reuse_windows = c.integer<int>({"reuse_windows", "past windows whose secant columns IQN-ILS reuses",
+                                                text(acceleration_default.reuse_windows), Range::between(0, 100)});
+  a.max_columns = c.integer<int>({"max_columns", "most secant columns of IQN-ILS",
+                                              text(acceleration_default.max_columns), Range::between(1, 10000)});
   a.filter = c.number({"filter", "IQN-ILS QR2 filter: drop a column whose new part is below this fraction of it",
                        text(acceleration_default.filter), Range{0.0, 1.0, false, false}});
-  sc.min_iterations = static_cast<int>(c.integer({"min_iterations", "sub-iterations at least",
-                                                  text(scheme_default.min_iterations), Range::between(1, 1000)}));
-  sc.max_iterations = static_cast<int>(c.integer({"max_iterations", "sub-iterations at most",
-                                                  text(scheme_default.max_iterations), Range::between(1, 10000)}));
+  sc.min_iterations = c.integer<int>({"min_iterations", "sub-iterations at least",
+                                                  text(scheme_default.min_iterations), Range::between(1, 1000)});
+  sc.max_iterations = c.integer<int>({"max_iterations", "sub-iterations at most",
+                                                  text(scheme_default.max_iterations), Range::between(1, 10000)});
   if (sc.max_iterations < sc.min_iterations) c.fail("max_iterations", "must not be below min_iterations");
   sc.stop_on_divergence = c.choice({"on_divergence", "a window not converged in max_iterations: \"stop\" the run, "
                                                      "or \"continue\" with its last iterate (recorded)",

@@ -3,8 +3,10 @@
 
 #include <spdlog/spdlog.h>
 
+#include "common/output_folder.hpp"
 #include "common/program.hpp"
 #include "common/progress.hpp"
+#include "common/stop.hpp"
 #include "mpm_solid/output.hpp"
 #include "mpm_solid/scene_reader.hpp"
 
@@ -16,19 +18,22 @@ int run(const RunOptions& options, scene::Document& doc) {
   auto root = doc.root();
   const SceneHeader header = read_scene_header(root);
   require_solvers(root, header, {"mpm"}, "mpm-solid");
-  mpm::Setup setup = mpm::read_setup(*root.table("mpm", "the material point solver", true));
+  const auto mpm_table = root.table("mpm", "the material point solver", true);
+  mpm::Setup setup = mpm::read_setup(*mpm_table);
   doc.reject_unused();
+  mpm::check_run_length(*mpm_table, setup, header.end_time);
 
   // The particles exist now: a fixed step can be checked against their CFL limit
   // (before --check returns, so it catches an unstable step too).
   mpm::Solver solver(setup.grid, std::move(setup.materials), std::move(setup.particles), setup.settings);
   const double stable = solver.stable_time_step();
   if (setup.fixed_time_step && *setup.fixed_time_step > stable / setup.settings.courant)
-    throw scene::Error(fmt::format(
-        "{}: key 'mpm.time_step': {:.3g} s exceeds the stability limit h / (c + |v|) = {:.3g} s of this scene; "
-        "use a smaller step or drop the key to let the CFL condition choose",
-        doc.file().string(), *setup.fixed_time_step, stable / setup.settings.courant));
+    mpm_table->fail("time_step", fmt::format("{:.3g} s exceeds the stability limit h / (c + |v|) = {:.3g} s of this "
+                                             "scene; use a smaller step or drop the key to let the CFL condition "
+                                             "choose",
+                                             *setup.fixed_time_step, stable / setup.settings.courant));
   if (!finish_reading(options, doc)) return 0;
+  const OutputFolder folder(options.output_directory(), "mpm-solid", options.overwrite);
   spdlog::info("{}: {} particles, {} x {} cells of {:g} m, stable step {:.3g} s", header.title,
                solver.particles().size(), setup.grid.cells[0], setup.grid.cells[1], setup.grid.h, stable);
 
@@ -38,7 +43,7 @@ int run(const RunOptions& options, scene::Document& doc) {
     spdlog::info("settled for {:.3g} s: kinetic energy down to {:.2e} of its peak; supports removed",
                  setup.settling.duration, left);
   }
-  mpm::Output out(options.output_directory(), run_info("mpm-solid", doc, "SI: m, s, kg, Pa; 2D plane strain, "
+  mpm::Output out(folder.path(), run_info("mpm-solid", doc, "SI: m, s, kg, Pa; 2D plane strain, "
                                                                          "per metre of depth"),
                   setup.tracers);
   out.snapshot(solver);
@@ -64,10 +69,15 @@ int run(const RunOptions& options, scene::Document& doc) {
     progress.update(solver.steps(), solver.time(), dt, fmt::format("particles {}", solver.particles().size()));
     const bool output_due = solver.time() >= target * (1 - 1e-12);
     at_rest = rest.active() && rest.at_rest(solver.kinetic_energy());
-    if (output_due || at_rest) {
+    const bool stop = stop_requested();  // read once: a signal may come in between
+    if (output_due || at_rest || stop) {
       out.snapshot(solver);
       last_snapshot_time = solver.time();
       if (output_due) next_output += header.output_interval;
+    }
+    if (stop) {
+      progress.finish();
+      return report_stop(solver.time(), out.series().index_path());
     }
     if (at_rest) break;
   }

@@ -78,6 +78,7 @@ void Output::history(const Solver& solver, const StepInfo& step) {
       e.strain, e.gravity, e.plastic, e.damage, e.damping, e.walls, e.transfer, e.left, e.external,
       e.total() - *initial_total_);
   history_.flush();
+  if (!history_) throw std::runtime_error("cannot write mpm_history.csv: the disk may be full");
   if (tracers_.empty()) return;
   const auto& p = solver.particles();
   for (std::size_t i = 0; i < p.size(); ++i) {
@@ -92,6 +93,7 @@ void Output::history(const Solver& solver, const StepInfo& step) {
                                 p.damage.empty() ? 0.0 : p.damage[i]);
   }
   tracer_file_.flush();
+  if (!tracer_file_) throw std::runtime_error("cannot write tracers.csv: the disk may be full");
 }
 
 void Output::finish() const {

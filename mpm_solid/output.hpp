@@ -23,6 +23,7 @@ class Output {
   void snapshot(const Solver& solver);
   void history(const Solver& solver, const StepInfo& step);
   const output::FieldSeries& series() const { return series_; }
+  output::FieldSeries& series() { return series_; }
   // The energy books of the histories written so far; at the end of a run,
   // finish() warns in the log if they are open by more than 1 % of their
   // largest term (the method lost or, worse, created energy).

@@ -1,10 +1,16 @@
 #include "mpm_solid/scene_reader.hpp"
 
+#include <omp.h>
+
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <tuple>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
+
+#include "common/limits.hpp"
 
 namespace outburst::mpm {
 
@@ -60,6 +66,15 @@ void read_platens(const scene::Table& s, Settings& st, const Grid<2>& grid) {
     if (!(hiv.array() > lov.array()).all()) t.fail("box_max", "must lie above and right of box_min");
     if ((hiv.array() < grid.lower.array()).any() || (lov.array() > grid.upper.array()).any())
       t.fail("box_min", "the platen lies outside the grid");
+    // Grid nodes lie every h from the grid's corner, ghost nodes included.
+    for (int d = 0; d < 2; ++d) {
+      const double first = std::max(std::ceil((lov[d] - grid.lower[d]) / grid.h), -1.0 * Grid<2>::ghost);
+      const double last = std::min(std::floor((hiv[d] - grid.lower[d]) / grid.h), 1.0 * grid.cells[d] + Grid<2>::ghost);
+      if (first > last)
+        t.fail("box_min", fmt::format("the platen's box holds no grid node: along {} the nodes lie every {:g} m from "
+                                      "{:g} m",
+                                      d == 0 ? 'x' : 'y', grid.h, grid.lower[d]));
+    }
     const std::string direction =
         t.choice({"direction", "the axis the plate moves along: \"x\" or \"y\""}, {"x", "y"});
     const double force = t.quantity({"force", "load on the plate along that axis per metre of depth (negative: "
@@ -68,6 +83,17 @@ void read_platens(const scene::Table& s, Settings& st, const Grid<2>& grid) {
     st.platens.push_back({lov, hiv, direction == "x" ? 0 : 1, force});
   }
 }
+
+// What the solver holds per grid node, counted low: mass, momentum, force
+// and two velocities, the node's coordinates, and each further thread's copy
+// of the scattered mass and vectors.
+double bytes_per_node() {
+  return 80.0 + 24.0 * (omp_get_max_threads() - 1);
+}
+
+// What a particle holds, counted low (position, velocity, stress, gradients:
+// Particles<2> without its optional fields).
+constexpr double bytes_per_particle = 224;
 
 // Index of the obstacle strictly containing x, if any.
 std::optional<std::size_t> obstacle_at(const std::vector<Obstacle>& obstacles, const Vec<2>& x) {
@@ -88,6 +114,40 @@ bool inside_polygon(const std::vector<Vec<2>>& poly, const Vec<2>& x) {
   }
   return in;
 }
+
+// Two edges of a polygon that cross or touch, other than neighbours meeting at
+// their shared vertex.
+std::optional<std::pair<std::size_t, std::size_t>> crossing_edges(const std::vector<Vec<2>>& poly) {
+  const auto orientation = [](const Vec<2>& a, const Vec<2>& b, const Vec<2>& c) {
+    const double cross = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
+    return (cross > 0) - (cross < 0);
+  };
+  const auto on_segment = [](const Vec<2>& a, const Vec<2>& b, const Vec<2>& c) {
+    return (c.array() >= a.cwiseMin(b).array()).all() && (c.array() <= a.cwiseMax(b).array()).all();
+  };
+  const std::size_t n = poly.size();
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = i + 1; j < n; ++j) {
+      if (j == i + 1 || (i == 0 && j == n - 1)) continue;
+      const Vec<2>&a = poly[i], &b = poly[(i + 1) % n], &c = poly[j], &d = poly[(j + 1) % n];
+      const int o1 = orientation(a, b, c), o2 = orientation(a, b, d), o3 = orientation(c, d, a),
+                o4 = orientation(c, d, b);
+      if ((o1 != o2 && o3 != o4) || (o1 == 0 && on_segment(a, b, c)) || (o2 == 0 && on_segment(a, b, d)) ||
+          (o3 == 0 && on_segment(c, d, a)) || (o4 == 0 && on_segment(c, d, b)))
+        return std::pair{i, j};
+    }
+  return std::nullopt;
+}
+
+// A body's shape, for telling whether another body's particles fall inside it.
+struct BodyShape {
+  Vec<2> lo, hi;
+  std::vector<Vec<2>> polygon;  // empty: the box
+  bool holds(const Vec<2>& x) const {
+    return (x.array() >= lo.array()).all() && (x.array() <= hi.array()).all() &&
+           (polygon.empty() || inside_polygon(polygon, x));
+  }
+};
 
 // A traction loads the outermost layer of particles facing one way inside a
 // box: each carries the traction times its share of the surface (its spacing).
@@ -139,7 +199,7 @@ Setup read_setup(const scene::Table& s) {
     st.flip_fraction = s.number({"flip_fraction", "FLIP/PIC blend: 1 pure FLIP, 0 pure PIC", "0.99",
                                  Range::between(0, 1)});
   st.courant = s.number({"courant", "time step as a fraction of the CFL limit h / (c + |v|)", "0.3",
-                         Range::between(0, 1)});
+                         Range{0.0, 1.0, false, true}});
   st.smooth_dilatation = s.choice({"locking_remedy",
                                    "\"nodal_dilatation\": smooth the volumetric strain rate over the nodes "
                                    "(against volumetric locking and pressure checkerboards), or \"none\"",
@@ -167,8 +227,14 @@ Setup read_setup(const scene::Table& s) {
   Grid<2>& gr = setup.grid;
   gr.h = h;
   gr.lower = {origin[0], origin[1]};
+  const std::array<double, 2> cells{size[0] / h, size[1] / h};
+  const double nodes = (cells[0] + 1 + 2 * Grid<2>::ghost) * (cells[1] + 1 + 2 * Grid<2>::ghost);
+  limits::refuse_memory(*grid, "cell_size", nodes * bytes_per_node(),
+                        fmt::format("a grid of {:.3g} x {:.3g} cells of {:g} m", cells[0], cells[1], h));
   for (int d = 0; d < 2; ++d) {
-    const double n = size[d] / h;
+    const double n = cells[static_cast<std::size_t>(d)];
+    if (n > std::numeric_limits<int>::max() / 2)
+      grid->fail("cell_size", fmt::format("{:.3g} cells along one side are more than a grid may have", n));
     gr.cells[d] = static_cast<int>(std::lround(n));
     if (std::abs(n - gr.cells[d]) > 1e-9 * n || gr.cells[d] < 1)
       grid->fail("cell_size", fmt::format("the grid size {:g} m is not a whole number of cells of {:g} m", size[d], h));
@@ -258,36 +324,58 @@ Setup read_setup(const scene::Table& s) {
 
   const auto bodies = s.table_array("bodies", "regions filled with particles");
   if (bodies.empty()) s.fail("bodies", "give at least one [[mpm.bodies]] to fill with particles");
+  std::vector<BodyShape> shapes;
+  double particle_bytes = 0;
   for (const auto& b : bodies) {
     const std::string material = b.string({"material", "name of one of the [[mpm.materials]]"});
     const auto found = std::find(names.begin(), names.end(), material);
     if (found == names.end())
       b.fail("material", fmt::format("no material \"{}\" (defined: {})", material, fmt::join(names, ", ")));
     const int index = static_cast<int>(found - names.begin());
-    const int ppc = static_cast<int>(b.integer({"particles_per_cell", "n for n x n particles per cell", "2",
-                                                Range::between(1, 8)}));
-    std::vector<Vec<2>> points;
+    const int ppc = b.integer<int>({"particles_per_cell", "n for n x n particles per cell", "2",
+                                                Range::between(1, 8)});
+    BodyShape shape;
     if (b.has("polygon")) {
-      std::vector<Vec<2>> polygon;
       for (const auto& v : b.quantity_points({"polygon", "vertices [[\"x m\", \"y m\"], ...] in order"},
                                              units::length))
-        polygon.emplace_back(v[0], v[1]);
-      if (polygon.size() < 3) b.fail("polygon", "a polygon needs at least 3 vertices");
-      Vec<2> lo = polygon[0], hi = polygon[0];
-      for (const auto& v : polygon) {
-        lo = lo.cwiseMin(v);
-        hi = hi.cwiseMax(v);
+        shape.polygon.emplace_back(v[0], v[1]);
+      if (shape.polygon.size() < 3) b.fail("polygon", "a polygon needs at least 3 vertices");
+      if (const auto crossing = crossing_edges(shape.polygon))
+        b.fail("polygon", fmt::format("the polygon crosses itself: its edge from vertex {} meets its edge from "
+                                      "vertex {} (vertices count from 0)",
+                                      crossing->first, crossing->second));
+      shape.lo = shape.hi = shape.polygon[0];
+      for (const auto& v : shape.polygon) {
+        shape.lo = shape.lo.cwiseMin(v);
+        shape.hi = shape.hi.cwiseMax(v);
       }
-      fill_cells(gr, ppc, lo, hi, [&](const Vec<2>& x) { return inside_polygon(polygon, x); }, points);
     } else {
       const auto lo = b.quantity_vector({"box_min", "lower-left corner of a rectangular body"}, units::length, 2);
       const auto hi = b.quantity_vector({"box_max", "upper-right corner of a rectangular body"}, units::length, 2);
-      const Vec<2> lov(lo[0], lo[1]), hiv(hi[0], hi[1]);
-      if (!((hiv.array() > lov.array()).all())) b.fail("box_max", "must lie above and right of box_min");
-      fill_cells(gr, ppc, lov, hiv, [](const Vec<2>&) { return true; }, points);
+      shape.lo = {lo[0], lo[1]};
+      shape.hi = {hi[0], hi[1]};
+      if (!((shape.hi.array() > shape.lo.array()).all())) b.fail("box_max", "must lie above and right of box_min");
     }
     const char* shape_key = b.has("polygon") ? "polygon" : "box_min";
+    if (const auto past = overhang(gr, shape.lo, shape.hi); !past.empty())
+      b.fail(overhang(gr, shape.lo, shape.lo).empty() && !b.has("polygon") ? "box_max" : shape_key,
+             fmt::format("the body reaches {}; the grid holds [{:g}, {:g}] x [{:g}, {:g}] m, and particles past it "
+                         "would be dropped",
+                         past, gr.lower.x(), gr.upper.x(), gr.lower.y(), gr.upper.y()));
+    particle_bytes += (shape.hi - shape.lo).prod() / (h * h) * ppc * ppc * bytes_per_particle;
+    limits::refuse_memory(b, shape_key, particle_bytes + nodes * bytes_per_node(),
+                          fmt::format("the particles of bodies 0 to {} ({} per cell) and the grid",
+                                      shapes.size(), ppc * ppc));
+    std::vector<Vec<2>> points;
+    fill_cells(gr, ppc, shape.lo, shape.hi, [&](const Vec<2>& x) { return shape.holds(x); }, points);
     if (points.empty()) b.fail(shape_key, "the body holds no particle positions of the grid");
+    for (const auto& x : points)
+      for (std::size_t k = 0; k < shapes.size(); ++k)
+        if (shapes[k].holds(x))
+          b.fail(shape_key, fmt::format("the body overlaps mpm.bodies[{}] at ({:g}, {:g}) m: the particles there "
+                                        "would be doubled",
+                                        k, x.x(), x.y()));
+    shapes.push_back(std::move(shape));
     for (const auto& x : points)
       if (const auto k = obstacle_at(st.obstacles, x))
         b.fail(shape_key, fmt::format("the body overlaps obstacle {} (mpm.obstacles[{}]) at ({:g}, {:g}) m", *k + 1,
@@ -312,6 +400,10 @@ Setup read_setup(const scene::Table& s) {
                                                            "each at t = 0 has its history written"},
                                                units::length)) {
       const Vec<2> x(point[0], point[1]);
+      if (!gr.inside(x))
+        s.fail("tracers", fmt::format("the tracer at ({:g}, {:g}) m lies outside the grid, which holds [{:g}, {:g}] x "
+                                      "[{:g}, {:g}] m",
+                                      x.x(), x.y(), gr.lower.x(), gr.upper.x(), gr.lower.y(), gr.upper.y()));
       std::size_t nearest = 0;
       for (std::size_t i = 1; i < setup.particles.size(); ++i)
         if ((setup.particles.x[i] - x).squaredNorm() < (setup.particles.x[nearest] - x).squaredNorm()) nearest = i;
@@ -319,6 +411,52 @@ Setup read_setup(const scene::Table& s) {
     }
   }
   return setup;
+}
+
+}  // namespace outburst::mpm
+
+namespace outburst::mpm {
+
+std::string overhang(const Grid<2>& grid, const Vec<2>& lo, const Vec<2>& hi) {
+  const double tolerance = 1e-9 * grid.h;
+  const std::array<std::tuple<double, const char*, char, double>, 4> sides{{
+      {grid.lower.x() - lo.x(), "left", 'x', grid.lower.x()},
+      {hi.x() - grid.upper.x(), "right", 'x', grid.upper.x()},
+      {grid.lower.y() - lo.y(), "bottom", 'y', grid.lower.y()},
+      {hi.y() - grid.upper.y(), "top", 'y', grid.upper.y()},
+  }};
+  std::string text;
+  for (const auto& [past, side, axis, edge] : sides)
+    if (past > tolerance)
+      text += fmt::format("{}{:g} m past the grid's {} edge ({} = {:g} m)", text.empty() ? "" : " and ", past, side,
+                          axis, edge);
+  return text;
+}
+
+void check_run_length(const scene::Table& mpm, const Setup& setup, double end_time) {
+  const double span = setup.settling.duration + end_time;
+  if (setup.fixed_time_step) {
+    limits::refuse_count(mpm, "time_step", span / *setup.fixed_time_step, limits::max_steps, "MPM steps",
+                         fmt::format("settling and end_time, {:.3g} s, in steps of {:.3g} s; lengthen time_step", span,
+                                     *setup.fixed_time_step));
+    return;
+  }
+  // The stable step at the start, as the solver computes it.
+  const auto& p = setup.particles;
+  double fastest = 0;
+  std::size_t material = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const std::size_t m = static_cast<std::size_t>(p.material[i]);
+    const double speed = setup.materials[m]->elasticity().p_wave_speed() + p.v[i].norm();
+    if (speed > fastest) fastest = speed, material = m;
+  }
+  const double step = setup.settings.courant * setup.grid.h / fastest;
+  limits::refuse_count(
+      mpm, "courant", span / step, limits::max_steps, "MPM steps",
+      fmt::format("settling and end_time, {:.3g} s, in stable steps of courant {:g} x cell {:g} m / {:.3g} m/s, the "
+                  "speed of the P wave of material \"{}\" (youngs_modulus, density) and its particles; change those "
+                  "or shorten the run",
+                  span, setup.settings.courant, setup.grid.h, fastest, setup.materials[material]->name()));
 }
 
 }  // namespace outburst::mpm

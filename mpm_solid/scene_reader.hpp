@@ -2,8 +2,12 @@
 // Reads the [mpm] section of a scene: grid, walls, materials and the bodies
 // that fill regions with particles. `mpm-solid SCENE --explain` lists every key.
 
+#include <algorithm>
+#include <cmath>
 #include <memory>
+#include <utility>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "common/scene.hpp"
@@ -23,13 +27,28 @@ struct Setup {
 
 Setup read_setup(const scene::Table& mpm);
 
+// How far the box [lo, hi] reaches past the grid, as "2 m past the grid's
+// right edge (x = 45 m)"; empty when it lies inside.
+std::string overhang(const Grid<2>& grid, const Vec<2>& lo, const Vec<2>& hi);
+
+// Refuses, at mpm.courant (or mpm.time_step), a run of more steps than any
+// run may take, estimated from the stable step at the start.
+void check_run_length(const scene::Table& mpm, const Setup& setup, double end_time);
+
 // Particles at n x n regular positions per grid cell, kept where `inside` holds.
 template <class Inside>
 void fill_cells(const Grid<2>& grid, int per_cell, const Vec<2>& lo, const Vec<2>& hi, Inside inside,
                 std::vector<Vec<2>>& points) {
   const double h = grid.h, step = h / per_cell;
-  for (int j = 0; j < grid.cells[1]; ++j)
-    for (int i = 0; i < grid.cells[0]; ++i)
+  // Only the cells [lo, hi] touches: a small body on a big grid is filled in no time.
+  const auto cells_between = [&](int d) {
+    const auto at = [&](double x) { return static_cast<int>(std::clamp(x, 0.0, static_cast<double>(grid.cells[d]))); };
+    return std::pair{at(std::floor((lo[d] - grid.lower[d]) / h)), at(std::ceil((hi[d] - grid.lower[d]) / h))};
+  };
+  const auto [i0, i1] = cells_between(0);
+  const auto [j0, j1] = cells_between(1);
+  for (int j = j0; j < j1; ++j)
+    for (int i = i0; i < i1; ++i)
       for (int b = 0; b < per_cell; ++b)
         for (int a = 0; a < per_cell; ++a) {
           const Vec<2> x = grid.lower + Vec<2>(i * h + (a + 0.5) * step, j * h + (b + 0.5) * step);

@@ -13,11 +13,13 @@ CellLocator::CellLocator(const Mesh& mesh) : mesh_(mesh) {
     lo = lo.cwiseMin(p);
     hi = hi.cwiseMax(p);
   }
-  // About one cell per bucket on average, in buckets matching the domain's shape.
+  // About one cell per bucket on average, in buckets matching the domain's
+  // shape; never more buckets than cells, however thin the domain (a mesh
+  // 3e-22 m high asked for 1.6e8 buckets).
   const Eigen::Vector2d extent = (hi - lo).cwiseMax(1e-12);
   const double cells = static_cast<double>(mesh.num_cells());
   const double aspect = extent.x() / extent.y();
-  nx_ = std::max(1, static_cast<int>(std::sqrt(cells * aspect)));
+  nx_ = static_cast<int>(std::clamp(std::sqrt(cells * aspect), 1.0, cells));
   ny_ = std::max(1, static_cast<int>(cells / nx_));
   lower_ = lo;
   bucket_size_ = extent.cwiseQuotient(Eigen::Vector2d(nx_, ny_));

@@ -24,6 +24,8 @@ class CellLocator {
   // `hint`, if given, is a cell to try first (where the point was last time);
   // it is updated to the cell found. Any hint is safe: a wrong one costs one test.
   std::optional<Hit> locate(const Eigen::Vector2d& point, int* hint = nullptr) const;
+  // Buckets of the search grid: at most one per cell.
+  std::size_t buckets() const { return bucket_start_.size() - 1; }
 
  private:
   const Mesh& mesh_;

@@ -4,8 +4,10 @@
 #include <spdlog/spdlog.h>
 
 #include "common/blas.hpp"
+#include "common/output_folder.hpp"
 #include "common/program.hpp"
 #include "common/progress.hpp"
+#include "common/stop.hpp"
 #include "seepage_fe/output.hpp"
 #include "seepage_fe/scene_reader.hpp"
 
@@ -17,7 +19,9 @@ int run(const RunOptions& options, scene::Document& doc) {
   auto root = doc.root();
   const SceneHeader header = read_scene_header(root);
   require_solvers(root, header, {"seepage"}, "seepage-fe");
-  seepage::Setup setup = seepage::read_setup(*root.table("seepage", "the gas seepage solver", true));
+  const auto seepage_table = root.table("seepage", "the gas seepage solver", true);
+  seepage::Setup setup = seepage::read_setup(*seepage_table);
+  seepage::check_run_length(*seepage_table, setup.steps, header.end_time, header.output_interval);
   if (!finish_reading(options, doc)) return 0;
 
   const auto wall_start = std::chrono::steady_clock::now();
@@ -28,8 +32,8 @@ int run(const RunOptions& options, scene::Document& doc) {
                solver.mesh().num_nodes(), solver.mesh().num_cells(), gas ? "gas" : "linear",
                format_duration(header.end_time));
 
-  const auto directory = options.output_directory();
-  seepage::Output out(directory, run_info("seepage-fe", doc, gas ? "SI: m, s, Pa; P = p^2 in Pa^2; "
+  const OutputFolder folder(options.output_directory(), "seepage-fe", options.overwrite);
+  seepage::Output out(folder.path(), run_info("seepage-fe", doc, gas ? "SI: m, s, Pa; P = p^2 in Pa^2; "
                                                                   "gas volumes at standard conditions"
                                                                 : "SI: m, s, Pa"),
                       solver);
@@ -47,9 +51,13 @@ int run(const RunOptions& options, scene::Document& doc) {
     out.history(solver, h, report);
     progress.update(solver.steps(), solver.time(), h,
                     fmt::format("iterations {}", report.nonlinear_iterations));
-    if (solver.time() >= target * (1 - 1e-12)) {
-      out.snapshot(solver);
-      next_output += header.output_interval;
+    const bool output_due = solver.time() >= target * (1 - 1e-12);
+    const bool stop = stop_requested();  // read once: a signal may come in between
+    if (output_due || stop) out.snapshot(solver);
+    if (output_due) next_output += header.output_interval;
+    if (stop) {
+      progress.finish();
+      return report_stop(solver.time(), out.series().index_path());
     }
     // A step shortened to land on an output time does not shrink the next one.
     if (h == dt) dt = std::min(dt * setup.steps.growth, setup.steps.maximum);

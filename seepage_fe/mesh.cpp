@@ -1,7 +1,10 @@
 #include "seepage_fe/mesh.hpp"
 
+#include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <sstream>
 #include <stdexcept>
@@ -95,6 +98,9 @@ class MshReader {
  public:
   MshReader(const std::filesystem::path& file) : file_(file), in_(file) {
     if (!in_) throw std::runtime_error(fmt::format("{}: cannot open the mesh file", file.string()));
+    std::error_code error;
+    size_ = std::filesystem::file_size(file, error);
+    if (error) throw std::runtime_error(fmt::format("{}: cannot read the mesh file's size", file.string()));
   }
 
   [[noreturn]] void fail(const std::string& what) const {
@@ -120,14 +126,28 @@ class MshReader {
     return t;
   }
 
-  long integer(const std::string& token, const char* what) const {
-    try {
-      std::size_t used = 0;
-      const long v = std::stol(token, &used);
-      if (used == token.size()) return v;
-    } catch (const std::exception&) {
-    }
-    fail(fmt::format("expected {} (an integer), got '{}'", what, token));
+  template <class T = long>
+  T integer(const std::string& token, const char* what) const {
+    T v = 0;
+    const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), v);
+    if (ec == std::errc::result_out_of_range)
+      fail(fmt::format("{} {} is out of range (at most {})", what, token, std::numeric_limits<T>::max()));
+    if (ec != std::errc() || end != token.data() + token.size())
+      fail(fmt::format("expected {} (an integer), got '{}'", what, token));
+    return v;
+  }
+
+  // A count of records that follow, each taking a byte of the file at least:
+  // a count the rest of the file cannot hold is refused before anything is
+  // allocated for it.
+  long count(const std::string& token, const char* what) {
+    const long n = integer(token, what);
+    if (n < 0) fail(fmt::format("{} is {}; expected a count >= 0", what, n));
+    const auto at = in_.tellg();
+    const double left = at < 0 ? 0.0 : static_cast<double>(size_) - static_cast<double>(at);
+    if (static_cast<double>(n) > left)
+      fail(fmt::format("{} is {}, more than the rest of the file ({:.0f} bytes) holds", what, n, left));
+    return n;
   }
 
   double number(const std::string& token, const char* what) const {
@@ -154,6 +174,7 @@ class MshReader {
  private:
   std::filesystem::path file_;
   std::ifstream in_;
+  std::uintmax_t size_ = 0;
   int line_ = 0;
 };
 
@@ -181,6 +202,7 @@ Mesh read_gmsh(const std::filesystem::path& file, double length_scale) {
   struct RawCell {
     std::array<long, 4> tags;
     int physical;
+    int line;
   };
   struct RawEdge {
     std::array<long, 2> tags;
@@ -204,7 +226,7 @@ Mesh read_gmsh(const std::filesystem::path& file, double length_scale) {
       r.expect_end("$EndMeshFormat");
       seen_format = true;
     } else if (line == "$PhysicalNames") {
-      const long n = r.integer(r.tokens("the number of physical names")[0], "the number of names");
+      const long n = r.count(r.tokens("the number of physical names")[0], "the number of names");
       for (long i = 0; i < n; ++i) {
         auto t = r.tokens("a physical name 'dimension tag \"name\"'");
         r.expect_count(t, 3, "a physical name 'dimension tag \"name\"'");
@@ -212,26 +234,26 @@ Mesh read_gmsh(const std::filesystem::path& file, double length_scale) {
         for (std::size_t k = 3; k < t.size(); ++k) name += " " + t[k];
         if (name.size() >= 2 && name.front() == '"' && name.back() == '"')
           name = name.substr(1, name.size() - 2);
-        physical_names[{static_cast<int>(r.integer(t[0], "a dimension")),
-                        static_cast<int>(r.integer(t[1], "a physical tag"))}] = name;
+        physical_names[{r.integer<int>(t[0], "a dimension"), r.integer<int>(t[1], "a physical tag")}] = name;
       }
       r.expect_end("$EndPhysicalNames");
     } else if (line == "$Entities") {
       const auto counts = r.tokens("the entity counts");
       r.expect_count(counts, 4, "the entity counts 'points curves surfaces volumes'");
       for (int dim = 0; dim < 4; ++dim) {
-        const long n = r.integer(counts[dim], "an entity count");
+        const long n = r.count(counts[dim], "an entity count");
         for (long i = 0; i < n; ++i) {
           const auto t = r.tokens("an entity");
           // Points carry x y z before their physical tags; the others a bounding box.
           const std::size_t at = dim == 0 ? 4 : 7;
           r.expect_count(t, at + 1, "an entity record");
-          const long tag = r.integer(t[0], "an entity tag");
+          const int tag = r.integer<int>(t[0], "an entity tag");
           const long physicals = r.integer(t[at], "the number of physical tags");
           if (physicals > 0) {
             r.expect_count(t, at + 2, "the entity's physical tags");
-            entity_physical[{dim, static_cast<int>(tag)}] =
-                static_cast<int>(std::abs(r.integer(t[at + 1], "a physical tag")));
+            const int physical = r.integer<int>(t[at + 1], "a physical tag");
+            if (physical == std::numeric_limits<int>::min()) r.fail("a physical tag is out of range");
+            entity_physical[{dim, tag}] = std::abs(physical);
           }
         }
       }
@@ -239,11 +261,11 @@ Mesh read_gmsh(const std::filesystem::path& file, double length_scale) {
     } else if (line == "$Nodes") {
       const auto head = r.tokens("the node block header");
       r.expect_count(head, 4, "'numEntityBlocks numNodes minNodeTag maxNodeTag'");
-      const long blocks = r.integer(head[0], "the number of node blocks");
+      const long blocks = r.count(head[0], "the number of node blocks");
       for (long b = 0; b < blocks; ++b) {
         const auto bh = r.tokens("a node block header");
         r.expect_count(bh, 4, "'entityDim entityTag parametric numNodesInBlock'");
-        const long n = r.integer(bh[3], "the number of nodes in the block");
+        const long n = r.count(bh[3], "the number of nodes in the block");
         if (bh[2] != "0") r.fail("parametric node coordinates are not supported");
         std::vector<long> tags(static_cast<std::size_t>(n));
         for (long i = 0; i < n; ++i) tags[i] = r.integer(r.tokens("a node tag")[0], "a node tag");
@@ -258,14 +280,14 @@ Mesh read_gmsh(const std::filesystem::path& file, double length_scale) {
     } else if (line == "$Elements") {
       const auto head = r.tokens("the element block header");
       r.expect_count(head, 4, "'numEntityBlocks numElements minElementTag maxElementTag'");
-      const long blocks = r.integer(head[0], "the number of element blocks");
+      const long blocks = r.count(head[0], "the number of element blocks");
       for (long b = 0; b < blocks; ++b) {
         const auto bh = r.tokens("an element block header");
         r.expect_count(bh, 4, "'entityDim entityTag elementType numElementsInBlock'");
-        const int dim = static_cast<int>(r.integer(bh[0], "an entity dimension"));
-        const int entity = static_cast<int>(r.integer(bh[1], "an entity tag"));
+        const int dim = r.integer<int>(bh[0], "an entity dimension");
+        const int entity = r.integer<int>(bh[1], "an entity tag");
         const long type = r.integer(bh[2], "an element type");
-        const long n = r.integer(bh[3], "the number of elements in the block");
+        const long n = r.count(bh[3], "the number of elements in the block");
         const auto phys = entity_physical.find({dim, entity});
         if (dim == 2 && type != 3)
           r.fail(fmt::format("surface {} holds {}s; the seepage solver needs 4-node "
@@ -281,7 +303,7 @@ Mesh read_gmsh(const std::filesystem::path& file, double length_scale) {
             r.expect_count(t, 5, "a quadrangle 'tag n1 n2 n3 n4'");
             raw_cells.push_back({{r.integer(t[1], "a node tag"), r.integer(t[2], "a node tag"),
                                   r.integer(t[3], "a node tag"), r.integer(t[4], "a node tag")},
-                                 phys->second});
+                                 phys->second, r.line()});
           } else if (dim == 1 && phys != entity_physical.end()) {
             if (type != 1)
               r.fail(fmt::format("curve {} holds {}s; only 2-node lines are supported", entity,
@@ -305,21 +327,31 @@ Mesh read_gmsh(const std::filesystem::path& file, double length_scale) {
   Mesh mesh;
   std::unordered_map<long, int> index;
   std::map<int, int> region_of_physical;
-  const auto node_index = [&](long tag) {
+  const auto node_index = [&](long tag, int line) {
     const auto found = index.find(tag);
     if (found != index.end()) return found->second;
     const auto xy = node_xy.find(tag);
     if (xy == node_xy.end())
       throw std::runtime_error(
-          fmt::format("{}: an element uses node {}, which $Nodes does not define", file.string(), tag));
+          fmt::format("{}:{}: the element uses node {}, which $Nodes does not define", file.string(), line, tag));
     const int i = static_cast<int>(mesh.nodes.size());
     mesh.nodes.push_back(xy->second);
     index[tag] = i;
     return i;
   };
+  // A quadrangle given twice would count its area, storage and conductivity twice.
+  std::map<std::array<long, 4>, int> line_of_cell;
+  for (const auto& c : raw_cells) {
+    auto nodes = c.tags;
+    std::sort(nodes.begin(), nodes.end());
+    if (const auto [it, added] = line_of_cell.try_emplace(nodes, c.line); !added)
+      throw std::runtime_error(fmt::format("{}:{}: this quadrangle has the nodes of the one at line {}: a cell "
+                                           "given twice",
+                                           file.string(), c.line, it->second));
+  }
   for (const auto& c : raw_cells) {
     std::array<int, 4> cell{};
-    for (int k = 0; k < 4; ++k) cell[k] = node_index(c.tags[k]);
+    for (int k = 0; k < 4; ++k) cell[k] = node_index(c.tags[k], c.line);
     const auto [it, added] =
         region_of_physical.try_emplace(c.physical, static_cast<int>(mesh.region_names.size()));
     if (added) {

@@ -1,5 +1,7 @@
 #include "seepage_fe/output.hpp"
 
+#include <stdexcept>
+
 #include <fmt/format.h>
 
 namespace outburst::seepage {
@@ -48,6 +50,7 @@ void Output::history(const Solver& solver, double dt, const StepReport& report) 
   line += fmt::format(",{:.6e}\n", b.initial_stored > 0 ? b.error() / b.initial_stored : b.error());
   history_ << line;
   history_.flush();
+  if (!history_) throw std::runtime_error("cannot write seepage_history.csv: the disk may be full");
 }
 
 }  // namespace outburst::seepage

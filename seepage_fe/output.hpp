@@ -20,6 +20,7 @@ class Output {
   void history(const Solver& solver, double dt, const StepReport& report);
 
   const output::FieldSeries& series() const { return series_; }
+  output::FieldSeries& series() { return series_; }
 
  private:
   output::FieldSeries series_;

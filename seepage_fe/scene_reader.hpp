@@ -26,4 +26,10 @@ struct Setup {
 // sets the steps, so a coupled scene does not carry keys nothing uses).
 Setup read_setup(const scene::Table& seepage, bool own_time_steps = true);
 
+// Steps a run to end_time takes under this control (output times aside).
+double estimated_steps(const TimeStepControl& steps, double end_time);
+// Refuses, at seepage.time_step, a run of more steps than any run may take.
+void check_run_length(const scene::Table& seepage, const TimeStepControl& steps, double end_time,
+                      double output_interval);
+
 }  // namespace outburst::seepage

@@ -12,7 +12,7 @@ from paraview.simple import XDMFReader, servermanager
 
 program, scene, workdir, xdmf_name, fields = sys.argv[1:6]
 out = os.path.abspath(os.path.join(workdir, "out"))
-subprocess.run([program, scene, "--quiet", "-o", out] + sys.argv[6:], check=True)
+subprocess.run([program, scene, "--quiet", "-o", out, "--overwrite"] + sys.argv[6:], check=True)
 reader = XDMFReader(FileNames=[os.path.join(out, xdmf_name)])
 reader.UpdatePipelineInformation()
 times = list(reader.TimestepValues)

@@ -1,6 +1,9 @@
 // Output files: complete or absent, never truncated; provenance recorded.
 #include <catch2/catch.hpp>
 
+#include <sys/resource.h>
+
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -70,4 +73,84 @@ TEST_CASE("a series writes mesh, snapshots and an index listing only complete sn
   CHECK(r.string_attribute("/", "version") == "0.0");
   CHECK(r.string_attribute("/mesh/p", "unit") == "Pa");
   CHECK(r.number_attribute("/", "time") == 1.0);
+}
+
+TEST_CASE("a snapshot that cannot be finished (a full disk) fails with a clear error and leaves nothing",
+          "[output]") {
+  const auto dir = fresh_dir("full_disk");
+  // The disk "fills" at 1 kB: files may not grow past it, and a write beyond
+  // returns an error (EFBIG) instead of killing the process with SIGXFSZ.
+  rlimit before{};
+  getrlimit(RLIMIT_FSIZE, &before);
+  const auto handler = std::signal(SIGXFSZ, SIG_IGN);
+  const rlimit small{1024, before.rlim_max};
+  setrlimit(RLIMIT_FSIZE, &small);
+  std::string message;
+  {
+    hdf5::H5Writer w(dir / "snapshot.h5");
+    // 8 kB, which HDF5 used to hold in its cache and write as the file closed.
+    w.write("/p", std::vector<double>(1000, 1.0), "Pa");
+    try {
+      w.commit();
+    } catch (const std::runtime_error& e) {
+      message = e.what();
+    }
+    // Before: the close failed, commit() threw with the file still open, and
+    // this destructor closed it again: SIGSEGV inside HDF5.
+  }
+  setrlimit(RLIMIT_FSIZE, &before);
+  std::signal(SIGXFSZ, handler);
+  CHECK_THAT(message, Catch::Contains("cannot write " + (dir / "snapshot.h5").string() + ": File too large (") &&
+                          Catch::Contains("MB free on its disk)"));
+  CHECK(fs::is_empty(dir));
+}
+
+TEST_CASE("a scene text of any size is kept in every output file", "[output]") {
+  const auto dir = fresh_dir("big_scene");
+  // Before: over 64 kB the fixed-length attribute could not be written.
+  std::string text = "[scene]\ntitle = \"big\"\n";
+  while (text.size() < 300000) text += "# a long comment, as a big polygon or a long note would make it\n";
+  output::RunInfo info{"test", "0.0", "scene.toml", text, {}, "SI"};
+  output::FieldSeries series(dir, "run", info);
+  series.add_point_grid("particles");
+  output::Snapshot snap(0);
+  snap.set_points("particles", {0.5, 0.5, 0});
+  series.write(snap);
+  hdf5::H5Reader r(dir / "run_000000.h5");
+  CHECK(r.string_attribute("/", "scene_text") == text);
+  CHECK(r.string_attribute("/", "program") == "test");
+}
+
+TEST_CASE("series listed together list a time only once each of them has written it", "[output]") {
+  const auto dir = fresh_dir("together");
+  output::RunInfo info{"test", "0.0", "scene.toml", "", {}, "SI"};
+  output::FieldSeries first(dir / "a", "first", info), second(dir / "b", "second", info);
+  first.add_point_grid("particles");
+  second.add_point_grid("particles");
+  first.list_with_others();
+  second.list_with_others();
+  const auto snapshot = [](double t) {
+    output::Snapshot s(t);
+    s.set_points("particles", {0.5, 0.5, 0});
+    return s;
+  };
+  const auto times_listed = [](const output::FieldSeries& s) {
+    const std::string xdmf = read(s.index_path());
+    std::size_t n = 0;
+    for (auto at = xdmf.find("<Time "); at != std::string::npos; at = xdmf.find("<Time ", at + 1)) ++n;
+    return n;
+  };
+  first.write(snapshot(0));
+  second.write(snapshot(0));
+  CHECK_FALSE(fs::exists(first.index_path()));  // written, not yet listed
+  output::publish({&first, &second});
+  CHECK(times_listed(first) == 1);
+  CHECK(times_listed(second) == 1);
+  // The second series cannot write its next snapshot (its folder is gone): the
+  // first one's index must not list that time either. Before, the coupled
+  // run's seepage.xdmf listed 5 times beside a particles.xdmf with 4.
+  first.write(snapshot(1));
+  fs::remove_all(dir / "b");
+  CHECK_THROWS(second.write(snapshot(1)));
+  CHECK(times_listed(first) == 1);
 }

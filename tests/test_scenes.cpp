@@ -48,3 +48,16 @@ TEST_CASE("a coupled scene whose particles leave seepage cells reading as open s
   REQUIRE_THROWS_WITH(setup("1"), Catch::Contains("mpm.grid.cell_size") &&
                                       Catch::Contains("fill a seepage cell 0.5 m wide to as little as 44 %"));
 }
+
+TEST_CASE("a coupled scene whose seepage mesh reaches past the MPM grid is refused", "[scene][coupling]") {
+  const std::string scene = std::string(OUTBURST_SOURCE_DIR) + "/cases/gas_face/gas_face.toml";
+  const auto setup = [&](const std::string& origin) {
+    auto doc = scene::Document::load(scene, {"seepage.mesh.origin=" + origin});
+    return coupling::read_coupled_setup(doc->root());
+  };
+  REQUIRE_NOTHROW(setup(R"(["2 m", "1 m"])"));
+  // Before: accepted, every cell read open and the gas left in the first window.
+  CHECK_THROWS_WITH(setup(R"(["20 m", "1 m"])"), Catch::Contains("--set: key 'seepage.mesh.origin'") &&
+                                                      Catch::Contains("reaches 18 m past the grid's right edge (x = 6 m)"));
+  CHECK_THROWS_WITH(setup(R"(["-1 m", "1 m"])"), Catch::Contains("1 m past the grid's left edge (x = 0 m)"));
+}

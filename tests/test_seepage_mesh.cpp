@@ -103,6 +103,21 @@ TEST_CASE("broken meshes are rejected with the line and what was expected", "[se
       {"clockwise_bowtie.msh",
        header + entities + nodes + "$Elements\n1 1 1 1\n2 1 3 1\n1 1 3 2 4\n$EndElements\n",
        "is degenerate or not convex"},
+      // Before: std::bad_alloc, "cannot create std::vector larger than max_size()",
+      // a tag wrapped to another entity's, and a cell counted twice.
+      {"huge_count.msh", header + entities + "$Nodes\n1 1000000000000 1 4\n2 1 0 1000000000000\n1\n",
+       ":14: the number of nodes in the block is 1000000000000, more than the rest of the file"},
+      {"negative_count.msh", header + entities + "$Nodes\n1 4 1 4\n2 1 0 -1\n",
+       ":14: the number of nodes in the block is -1; expected a count >= 0"},
+      {"count_beyond_long.msh", header + entities + "$Nodes\n1 4 1 4\n2 1 0 99999999999999999999\n",
+       "the number of nodes in the block 99999999999999999999 is out of range"},
+      {"tag_beyond_int.msh",
+       header + "$PhysicalNames\n1\n2 1 \"coal\"\n$EndPhysicalNames\n"
+                "$Entities\n0 0 1 0\n4294967297 0 0 0 1 1 0 1 1 0\n$EndEntities\n" + nodes + quad,
+       ":10: an entity tag 4294967297 is out of range (at most 2147483647)"},
+      {"repeated_quad.msh",
+       header + entities + nodes + "$Elements\n1 2 1 2\n2 1 3 2\n1 1 2 3 4\n2 2 3 4 1\n$EndElements\n",
+       ":28: this quadrangle has the nodes of the one at line 27: a cell given twice"},
   };
   for (const auto& row : rows) {
     INFO(row.name);
@@ -126,7 +141,21 @@ TEST_CASE("points are located in their cell on generated and Gmsh meshes", "[see
     for (int a = 0; a < 4; ++a) back += n[a] * m.nodes[hc[a]];
     CHECK((back - centre).norm() < 1e-12);
   }
+  CHECK(locator.buckets() <= m.num_cells());
   CHECK_FALSE(locator.locate({-0.1, 0.5}));
   CHECK_FALSE(locator.locate({5.0, 1.2}));
   CHECK(locator.locate({10.0, 1.0}));  // a corner of the domain
+}
+
+TEST_CASE("a locator over a very thin mesh has no more buckets than cells", "[seepage][mesh]") {
+  // Found by fuzzing: a mesh 3e-22 m high asked for 1.6e8 buckets, 50 s and
+  // gigabytes before the first step.
+  StructuredMeshSpec spec;
+  spec.size = {30, 3e-22};
+  spec.cells = {150, 6};
+  spec.regions = {{"all", true, {}, {}}};
+  const Mesh m = make_structured_mesh(spec);
+  const CellLocator locator(m);
+  CHECK(locator.buckets() <= m.num_cells());
+  REQUIRE(locator.locate({15, 1e-22}));
 }

@@ -30,6 +30,7 @@ TEST_CASE("quantities convert to SI and carry their dimension", "[units]") {
       {"1e-3 Pa s", 1e-3, u::viscosity},
       {"1e-3 Pa.s", 1e-3, u::viscosity},
       {"0.5", 0.5, u::dimensionless},
+      {"2 MPa^-5e-1", 2e-3, u::gas_content_per_volume},
   };
   for (const auto& row : rows) {
     INFO(row.text);
@@ -46,6 +47,12 @@ TEST_CASE("malformed quantities are rejected with the reason", "[units]") {
       {"3 m/(s", "missing ')'"},
       {"3 m^", "expected an exponent"},
       {"3 m #", "unexpected '#'"},
+      // Numbers beyond a double: said so (before: "must be > 0", "unknown unit 'e'").
+      {"1e308 d", "\"1e308 d\" overflows: in SI it exceeds the largest number"},
+      {"1e-320 MPa^-40", "underflows"},
+      {"1e400 Pa", "is beyond the range of numbers"},
+      {"3 MPa^1e400", "1e400 is out of range"},
+      {"3 MPa^400", "the power ^400 takes the unit beyond the range of numbers"},
   };
   for (const auto& [text, message] : rows) {
     INFO(text);

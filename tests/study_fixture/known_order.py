@@ -1,6 +1,6 @@
 #!/usr/bin/python3
-"""A stand-in program for testing cases/study.py: takes a scene, -q, -o DIR and
---set model.KEY=VALUE like the real ones, and writes DIR/result.txt holding
+"""A stand-in program for testing cases/study.py: takes a scene, -q, -o DIR,
+--overwrite and --set model.KEY=VALUE like the real ones, and writes DIR/result.txt holding
 the error C h^order of a method of known order (the scene's [model])."""
 import argparse
 import os
@@ -13,6 +13,7 @@ def main():
     ap.add_argument("scene")
     ap.add_argument("-q", action="store_true")
     ap.add_argument("-o", required=True)
+    ap.add_argument("--overwrite", action="store_true")
     ap.add_argument("--set", action="append", default=[])
     args = ap.parse_args()
     with open(args.scene, "rb") as f:

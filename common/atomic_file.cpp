@@ -1,0 +1,62 @@
+#include "common/atomic_file.hpp"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+
+#include <fmt/format.h>
+
+namespace outburst::output {
+
+namespace {
+
+[[noreturn]] void fail(const std::filesystem::path& path, int error) {
+  std::error_code ignored;
+  const auto space = std::filesystem::space(path.parent_path().empty() ? "." : path.parent_path(), ignored);
+  throw std::runtime_error(fmt::format("cannot write {}: {} ({} MB free on its disk)", path.string(),
+                                       std::strerror(error), ignored ? 0 : space.available / 1000000));
+}
+
+}  // namespace
+
+std::filesystem::path write_beside(const std::filesystem::path& path, std::string_view bytes) {
+  std::filesystem::path temp = path;
+  temp += fmt::format(".partial-{}", ::getpid());
+  const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) fail(path, errno);
+  for (std::size_t done = 0; done < bytes.size();) {
+    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      const int error = n < 0 ? errno : ENOSPC;
+      ::close(fd);
+      ::unlink(temp.c_str());
+      fail(path, error);
+    }
+    done += static_cast<std::size_t>(n);
+  }
+  if (::close(fd) != 0) {
+    const int error = errno;
+    ::unlink(temp.c_str());
+    fail(path, error);
+  }
+  return temp;
+}
+
+void move_into_place(const std::filesystem::path& temp, const std::filesystem::path& path) {
+  if (::rename(temp.c_str(), path.c_str()) != 0) {
+    const int error = errno;
+    ::unlink(temp.c_str());
+    fail(path, error);
+  }
+}
+
+void write_file_atomically(const std::filesystem::path& path, std::string_view bytes) {
+  move_into_place(write_beside(path, bytes), path);
+}
+
+}  // namespace outburst::output

@@ -1,0 +1,98 @@
+#include "common/output_folder.hpp"
+
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cstring>
+#include <utility>
+#include <vector>
+
+#include <fmt/chrono.h>
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include "common/scene.hpp"
+
+namespace outburst {
+
+namespace {
+
+// What the programs write into an output folder.
+bool written_by_a_run(const std::string& name) {
+  const auto ends_with = [&](std::string_view end) { return name.ends_with(end); };
+  return ends_with(".xdmf") || ends_with(".h5") || name.find(".partial-") != std::string::npos ||
+         name == "seepage_history.csv" || name == "mpm_history.csv" || name == "tracers.csv" || name == "coupling.csv";
+}
+
+// The run a lock file names ("outburst, pid 1234, started ..."), or empty.
+std::string holder(int fd) {
+  std::string text(512, '\0');
+  const ssize_t n = ::pread(fd, text.data(), text.size(), 0);
+  text.resize(n > 0 ? static_cast<std::size_t>(n) : 0);
+  while (!text.empty() && (text.back() == '\n' || text.back() == '\0')) text.pop_back();
+  return text;
+}
+
+[[noreturn]] void refuse(const std::filesystem::path& directory, const std::string& why) {
+  throw scene::Error(fmt::format("output folder {}: {}", directory.string(), why));
+}
+
+}  // namespace
+
+OutputFolder::OutputFolder(std::filesystem::path directory, const std::string& program, bool overwrite)
+    : directory_(std::move(directory)) {
+  std::error_code error;
+  if (std::filesystem::exists(directory_, error) && !std::filesystem::is_directory(directory_, error))
+    refuse(directory_, "it exists and is not a folder; give a folder with -o");
+  std::filesystem::create_directories(directory_, error);
+  if (error) refuse(directory_, fmt::format("cannot create it: {}", error.message()));
+
+  int fd = ::open((directory_ / ".run.lock").c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (fd < 0) refuse(directory_, fmt::format("cannot write in it: {}", std::strerror(errno)));
+  // Closing the lock file releases the lock: done here unless the folder is taken.
+  struct Closer {
+    int& fd;
+    ~Closer() {
+      if (fd >= 0) ::close(fd);
+    }
+  } closer{fd};
+  if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+    const std::string running = holder(fd);
+    refuse(directory_, fmt::format("a run is still writing there ({}); wait for it, stop it, or choose another "
+                                   "folder with -o",
+                                   running.empty() ? "its lock is held" : running));
+  }
+  const std::string earlier = holder(fd);
+
+  std::filesystem::directory_iterator entries(directory_, error);
+  if (error) refuse(directory_, fmt::format("cannot list it: {}", error.message()));
+  std::vector<std::filesystem::path> files;
+  for (const auto& entry : entries)
+    if (written_by_a_run(entry.path().filename().string())) files.push_back(entry.path());
+  if (!files.empty() && !overwrite)
+    refuse(directory_, fmt::format("it holds the output of an earlier run ({}, {} files); pass --overwrite to "
+                                   "replace it, or choose another folder with -o",
+                                   earlier.empty() ? "of unknown origin" : earlier, files.size()));
+  for (const auto& f : files)
+    if (!std::filesystem::remove(f, error) && error)
+      refuse(directory_, fmt::format("cannot remove {} of the earlier run: {}", f.filename().string(), error.message()));
+  if (!files.empty())
+    spdlog::info("removed the {} files of an earlier run ({}) from {}", files.size(),
+                 earlier.empty() ? "of unknown origin" : earlier, directory_.string());
+
+  const std::string record = fmt::format("{}, pid {}, started {:%Y-%m-%d %H:%M:%S}\n", program, ::getpid(),
+                                         fmt::localtime(std::chrono::system_clock::to_time_t(
+                                             std::chrono::system_clock::now())));
+  if (::ftruncate(fd, 0) != 0 || ::pwrite(fd, record.data(), record.size(), 0) < 0)
+    refuse(directory_, fmt::format("cannot write its lock file: {}", std::strerror(errno)));
+  lock_ = std::exchange(fd, -1);
+}
+
+OutputFolder::~OutputFolder() {
+  if (lock_ >= 0) ::close(lock_);
+}
+
+}  // namespace outburst

@@ -1,0 +1,23 @@
+#pragma once
+// Stopping a run on request. SIGINT or SIGTERM only sets a flag (async-signal
+// safe); each program's run loop checks it after every step (or coupling
+// window), writes a snapshot of the state it reached, says so and exits with
+// exit_stopped. The histories are flushed line by line anyway. A second
+// signal ends the process at once, as the signal would by default.
+
+#include <filesystem>
+
+namespace outburst {
+
+// The exit code of a run stopped by SIGINT or SIGTERM.
+inline constexpr int exit_stopped = 3;
+
+// Installed by run_program() for every program.
+void install_stop_handlers();
+bool stop_requested();
+
+// Logs that the run stopped at `time` [s] with its last snapshot listed in
+// `index`; returns exit_stopped.
+int report_stop(double time, const std::filesystem::path& index);
+
+}  // namespace outburst

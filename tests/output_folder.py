@@ -1,0 +1,62 @@
+#!/usr/bin/python3
+"""An output folder serves one run at a time: a second run while the first
+lives is refused naming it (program, pid, start time); once the first is
+killed (kill -9) its stale lock blocks nothing, but its files are replaced
+only with --overwrite, which removes the earlier run's extra snapshots; -o
+naming a file is refused with exit code 2.
+
+usage: output_folder.py MPM_SOLID SCENE WORK_DIR"""
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+
+
+def run(program, scene, out, *extra):
+    done = subprocess.run([program, scene, "-q", "-o", out, *extra], capture_output=True, text=True)
+    lines = done.stderr.strip().splitlines()
+    return done.returncode, lines[-1] if lines else ""
+
+
+def main():
+    program, scene, work = sys.argv[1:4]
+    shutil.rmtree(work, ignore_errors=True)
+    os.makedirs(work)
+    out = os.path.join(work, "run")
+    failures = []
+
+    def expect(what, result, code, *words):
+        print(f"{what}: exit {result[0]}: {result[1]}")
+        if result[0] != code or not all(w in result[1] for w in words):
+            failures.append(f"{what}: exit {result[0]} '{result[1]}', expected {code} with {words}")
+
+    # A long run with many snapshots, killed once it has written more than a
+    # rerun of the scene writes (11).
+    first = subprocess.Popen([program, scene, "-q", "-o", out, "--set", 'scene.end_time="10 s"', "--set",
+                              'output.interval="0.001 s"'], stderr=subprocess.DEVNULL)
+    deadline = time.monotonic() + 60
+    while not os.path.exists(os.path.join(out, "particles_000020.h5")) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    expect("a second run while the first writes", run(program, scene, out), 2, "a run is still writing there",
+           f"mpm-solid, pid {first.pid}, started")
+    first.send_signal(signal.SIGKILL)
+    first.wait()
+    expect("a rerun after kill -9", run(program, scene, out), 2, "holds the output of an earlier run",
+           f"pid {first.pid}", "pass --overwrite")
+    expect("a rerun with --overwrite", run(program, scene, out, "--overwrite"), 0)
+    snapshots = sorted(n for n in os.listdir(out) if n.startswith("particles_"))
+    print(f"after the rerun: {len(snapshots)} snapshots")
+    if len(snapshots) != 11:  # the scene's end_time / interval + the initial one
+        failures.append(f"{len(snapshots)} snapshots after --overwrite, expected the rerun's 11 alone")
+
+    a_file = os.path.join(work, "a_file")
+    open(a_file, "w").close()
+    expect("-o naming a file", run(program, scene, a_file), 2, "it exists and is not a folder")
+    if failures:
+        sys.exit("; ".join(failures))
+
+
+if __name__ == "__main__":
+    main()
