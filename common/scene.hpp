@@ -11,6 +11,7 @@
 #include <array>
 #include <concepts>
 #include <filesystem>
+#include <initializer_list>
 #include <map>
 #include <memory>
 #include <optional>
@@ -18,6 +19,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "common/time_function.hpp"
@@ -113,6 +115,17 @@ class Table {
   std::string string(const Key& key) const;
   // One of a fixed set of words; the error lists them.
   std::string choice(const Key& key, const std::vector<std::string_view>& choices) const;
+  // One of a fixed set of words, each naming a value: the names and what they
+  // mean are declared once, at the call, and no word falls through to a default.
+  template <class T>
+  T choice(const Key& key, std::initializer_list<std::pair<std::string_view, T>> options) const {
+    std::vector<std::string_view> names;
+    for (const auto& o : options) names.push_back(o.first);
+    const std::string word = choice(key, names);
+    for (const auto& o : options)
+      if (o.first == word) return o.second;
+    throw std::logic_error("scene: a checked choice matched no option");
+  }
   std::vector<std::string> choice_list(const Key& key,
                                        const std::vector<std::string_view>& choices) const;
   // A file path, resolved relative to the scene file's folder.

@@ -12,13 +12,13 @@ using scene::Range;
 CouplingSetup read_coupling(const scene::Table& c) {
   CouplingSetup s;
   SchemeSettings& sc = s.scheme;
-  const std::string kind = c.choice({"scheme", "\"one_way\" (seepage drives the solid), \"explicit\" (one staggered "
-                                               "pass per window) or \"implicit\" (sub-iterations to convergence)",
-                                     "implicit"},
-                                    {"one_way", "explicit", "implicit"});
-  sc.kind = kind == "one_way"    ? SchemeSettings::Kind::one_way
-            : kind == "explicit" ? SchemeSettings::Kind::explicit_staggered
-                                 : SchemeSettings::Kind::implicit;
+  sc.kind = c.choice<SchemeSettings::Kind>(
+      {"scheme", "\"one_way\" (seepage drives the solid), \"explicit\" (one staggered pass per window) or "
+                 "\"implicit\" (sub-iterations to convergence)",
+       "implicit"},
+      {{"one_way", SchemeSettings::Kind::one_way},
+       {"explicit", SchemeSettings::Kind::explicit_staggered},
+       {"implicit", SchemeSettings::Kind::implicit}});
   s.window = c.quantity({"window", "coupling window: one seepage step, many MPM steps", "", Range::positive()},
                         units::time);
   sc.to_second = {"pressure"};
@@ -88,13 +88,12 @@ CouplingSetup read_coupling(const scene::Table& c) {
   }
 
   auto& a = sc.acceleration;
-  const std::string acc = c.choice({"acceleration", "implicit: \"iqn_ils\" (quasi-Newton), \"aitken\" or "
-                                                    "\"constant\" (under-relaxation)",
-                                    "iqn_ils"},
-                                   {"iqn_ils", "aitken", "constant"});
-  a.kind = acc == "iqn_ils"  ? AccelerationSettings::Kind::iqn_ils
-           : acc == "aitken" ? AccelerationSettings::Kind::aitken
-                             : AccelerationSettings::Kind::constant;
+  a.kind = c.choice<AccelerationSettings::Kind>(
+      {"acceleration", "implicit: \"iqn_ils\" (quasi-Newton), \"aitken\" or \"constant\" (under-relaxation)",
+       "iqn_ils"},
+      {{"iqn_ils", AccelerationSettings::Kind::iqn_ils},
+       {"aitken", AccelerationSettings::Kind::aitken},
+       {"constant", AccelerationSettings::Kind::constant}});
   a.relaxation = c.number({"relaxation", "constant: the factor; Aitken and IQN-ILS: that of a window's first "
                                          "iteration",
                            text(acceleration_default.relaxation), Range{0.0, 1.0, false, true}});

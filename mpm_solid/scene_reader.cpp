@@ -19,19 +19,15 @@ using scene::Range;
 
 namespace {
 
-Wall::Type wall_type(const std::string& type) {
-  if (type == "fixed") return Wall::Type::fixed;
-  if (type == "roller") return Wall::Type::roller;
-  if (type == "friction") return Wall::Type::friction;
-  return Wall::Type::open;
-}
-
 Wall read_wall(const scene::Table& t, std::string_view side, double friction) {
-  const std::string type = t.choice({side, "\"open\" (particles may leave), \"fixed\", \"roller\" (no normal "
-                                           "motion) or \"friction\" (Coulomb, unilateral)",
-                                     "open"},
-                                    {"open", "fixed", "roller", "friction"});
-  return {wall_type(type), type == "friction" ? friction : 0.0};
+  const auto type = t.choice<Wall::Type>({side, "\"open\" (particles may leave), \"fixed\", \"roller\" (no normal "
+                                                "motion) or \"friction\" (Coulomb, unilateral)",
+                                          "open"},
+                                         {{"open", Wall::Type::open},
+                                          {"fixed", Wall::Type::fixed},
+                                          {"roller", Wall::Type::roller},
+                                          {"friction", Wall::Type::friction}});
+  return {type, type == Wall::Type::friction ? friction : 0.0};
 }
 
 void read_obstacles(const scene::Table& s, Settings& st, const Grid<2>& grid) {
@@ -43,16 +39,19 @@ void read_obstacles(const scene::Table& s, Settings& st, const Grid<2>& grid) {
     if (!(hiv.array() > lov.array()).all()) o.fail("box_max", "must lie above and right of box_min");
     if ((hiv.array() <= grid.lower.array()).any() || (lov.array() >= grid.upper.array()).any())
       o.fail("box_min", "the obstacle lies outside the grid");
-    const std::string type = o.choice({"contact", "\"friction\" (Coulomb, material may separate), \"roller\" "
-                                                  "(bonded normal to the face, free to slide) or \"fixed\" (bonded)",
-                                       "friction"},
-                                      {"fixed", "roller", "friction"});
+    const auto type = o.choice<Wall::Type>({"contact", "\"friction\" (Coulomb, material may separate), \"roller\" "
+                                                       "(bonded normal to the face, free to slide) or \"fixed\" "
+                                                       "(bonded)",
+                                            "friction"},
+                                           {{"fixed", Wall::Type::fixed},
+                                            {"roller", Wall::Type::roller},
+                                            {"friction", Wall::Type::friction}});
     const double mu = o.number({"friction_coefficient", "Coulomb coefficient of a \"friction\" contact", "0",
                                 Range::non_negative()});
     const bool support = o.boolean({"support", "true: holds the material only during [mpm.settle] (the face "
                                                "before excavation); the dynamic stage starts without it",
                                     "false"});
-    st.obstacles.push_back({lov, hiv, {wall_type(type), type == "friction" ? mu : 0.0}, support});
+    st.obstacles.push_back({lov, hiv, {type, type == Wall::Type::friction ? mu : 0.0}, support});
   }
 }
 
@@ -75,12 +74,12 @@ void read_platens(const scene::Table& s, Settings& st, const Grid<2>& grid) {
                                       "{:g} m",
                                       d == 0 ? 'x' : 'y', grid.h, grid.lower[d]));
     }
-    const std::string direction =
-        t.choice({"direction", "the axis the plate moves along: \"x\" or \"y\""}, {"x", "y"});
+    const int axis =
+        t.choice<int>({"direction", "the axis the plate moves along: \"x\" or \"y\""}, {{"x", 0}, {"y", 1}});
     const double force = t.quantity({"force", "load on the plate along that axis per metre of depth (negative: "
                                               "toward smaller coordinates)"},
                                     units::force_per_length);
-    st.platens.push_back({lov, hiv, direction == "x" ? 0 : 1, force});
+    st.platens.push_back({lov, hiv, axis, force});
   }
 }
 
@@ -186,13 +185,11 @@ void read_tractions(const scene::Table& s, Setup& setup) {
 Setup read_setup(const scene::Table& s) {
   Setup setup;
   Settings& st = setup.settings;
-  const std::string scheme = s.choice(
-      {"scheme", "\"usf\" (update stress first, the paper's), \"usl\" or \"musl\"", "usf"}, {"usf", "usl", "musl"});
-  st.scheme = scheme == "usf" ? Scheme::usf : scheme == "usl" ? Scheme::usl : Scheme::musl;
-  const std::string shape =
-      s.choice({"shape", "grid shape functions: \"linear\", \"gimp\" or \"bspline\" (quadratic)", "bspline"},
-               {"linear", "gimp", "bspline"});
-  st.shape = shape == "linear" ? ShapeKind::linear : shape == "gimp" ? ShapeKind::gimp : ShapeKind::bspline;
+  st.scheme = s.choice<Scheme>({"scheme", "\"usf\" (update stress first, the paper's), \"usl\" or \"musl\"", "usf"},
+                               {{"usf", Scheme::usf}, {"usl", Scheme::usl}, {"musl", Scheme::musl}});
+  st.shape = s.choice<ShapeKind>(
+      {"shape", "grid shape functions: \"linear\", \"gimp\" or \"bspline\" (quadratic)", "bspline"},
+      {{"linear", ShapeKind::linear}, {"gimp", ShapeKind::gimp}, {"bspline", ShapeKind::bspline}});
   st.apic = s.choice({"transfer", "velocity transfer: \"flip\" (FLIP/PIC blend) or \"apic\" (affine PIC)", "flip"},
                      {"flip", "apic"}) == "apic";
   if (!st.apic)
@@ -309,13 +306,13 @@ Setup read_setup(const scene::Table& s) {
                                      "0 deg", Range::non_negative()},
                                     units::angle);
       if (psi > phi) m.fail("dilation_angle", "must not exceed the friction angle");
-      const std::string fit = m.choice({"fit", "Drucker-Prager cone fitted to Mohr-Coulomb: \"outer\" "
-                                               "(compression corners, the paper's), \"inner\" or \"plane_strain\"",
-                                        "outer"},
-                                       {"outer", "inner", "plane_strain"});
-      const auto kind = fit == "outer"   ? DruckerPragerFit::Kind::outer
-                        : fit == "inner" ? DruckerPragerFit::Kind::inner
-                                         : DruckerPragerFit::Kind::plane_strain;
+      const auto kind = m.choice<DruckerPragerFit::Kind>(
+          {"fit", "Drucker-Prager cone fitted to Mohr-Coulomb: \"outer\" (compression corners, the paper's), "
+                  "\"inner\" or \"plane_strain\"",
+           "outer"},
+          {{"outer", DruckerPragerFit::Kind::outer},
+           {"inner", DruckerPragerFit::Kind::inner},
+           {"plane_strain", DruckerPragerFit::Kind::plane_strain}});
       setup.materials.push_back(std::make_unique<DruckerPrager>(name, e, c, phi, psi, kind));
     }
     names.push_back(name);

@@ -117,16 +117,11 @@ Setup read_setup(const scene::Table& s, bool own_time_steps) {
                   : Law::linear;
 
   Settings& st = setup.settings;
-  st.scheme = s.choice({"time_scheme", "\"bdf2\" (second order, L-stable) or \"backward_euler\"",
-                        "bdf2"},
-                       {"bdf2", "backward_euler"}) == "bdf2"
-                  ? TimeScheme::bdf2
-                  : TimeScheme::backward_euler;
-  st.method = s.choice({"nonlinear_solver",
-                        "\"newton\" (with line search) or \"picard\" (secant storage)", "newton"},
-                       {"newton", "picard"}) == "newton"
-                  ? NonlinearMethod::newton
-                  : NonlinearMethod::picard;
+  st.scheme = s.choice<TimeScheme>({"time_scheme", "\"bdf2\" (second order, L-stable) or \"backward_euler\"", "bdf2"},
+                                   {{"bdf2", TimeScheme::bdf2}, {"backward_euler", TimeScheme::backward_euler}});
+  st.method = s.choice<NonlinearMethod>(
+      {"nonlinear_solver", "\"newton\" (with line search) or \"picard\" (secant storage)", "newton"},
+      {{"newton", NonlinearMethod::newton}, {"picard", NonlinearMethod::picard}});
   st.tolerance = s.number({"tolerance", "nonlinear convergence: max |du| / max |u|", "1e-10",
                            Range::positive()});
   st.max_iterations = s.integer<int>(
@@ -220,10 +215,9 @@ Setup read_setup(const scene::Table& s, bool own_time_steps) {
         b.fail("name", fmt::format("boundary \"{}\" already has a condition (seepage.boundaries[{}]); give each "
                                    "boundary one",
                                    bc.boundary, k));
-    bc.type = b.choice({"type", "\"pressure\" (fixed p) or \"flux\" (prescribed inflow)"},
-                       {"pressure", "flux"}) == "pressure"
-                  ? BoundaryCondition::Type::pressure
-                  : BoundaryCondition::Type::flux;
+    bc.type = b.choice<BoundaryCondition::Type>(
+        {"type", "\"pressure\" (fixed p) or \"flux\" (prescribed inflow)"},
+        {{"pressure", BoundaryCondition::Type::pressure}, {"flux", BoundaryCondition::Type::flux}});
     if (bc.type == BoundaryCondition::Type::pressure)
       bc.value = b.time_function({"value", "boundary pressure p, constant or [[time, p], ...]", "",
                                   model.law == Law::gas ? Range::positive() : Range{}},
