@@ -13,8 +13,9 @@ packages=(
   libhdf5-dev libtomlplusplus-dev libcli11-dev libspdlog-dev libfmt-dev catch2
   # figures, and ParaView's Python for checking that our output opens
   python3 python3-matplotlib python3-numpy python3-h5py python3-paraview
-  # scene files edited by the studies (comments kept)
-  python3-tomlkit
+  # scene files edited by the studies (comments kept); the outburst's finer
+  # seepage mesh, meshed from seam.geo by its sensitivity study
+  python3-tomlkit gmsh
 )
 
 missing=()
