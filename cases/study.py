@@ -68,7 +68,7 @@ KNOBS = {
     "courant": ("mpm.courant", "MPM Courant number"),
     "seepage_cells": ("seepage.mesh.cells", "structured seepage mesh cells [nx, ny]"),
     "seepage_time_step": ("seepage.time_step", "seepage (first) time step"),
-    "seepage_time_scheme": ("seepage.time_scheme", '"backward_euler", "crank_nicolson" or "bdf2"'),
+    "seepage_time_scheme": ("seepage.time_scheme", '"backward_euler" or "bdf2"'),
     "newton_tolerance": ("seepage.tolerance", "seepage nonlinear tolerance"),
     "coupling_scheme": ("coupling", '"explicit", "explicit_fixed_stress", "constant", "aitken" or "iqn_ils"'),
     "window": ("coupling.window", "coupling window"),
