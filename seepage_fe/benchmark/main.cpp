@@ -3,12 +3,12 @@
 //
 // Problem (as the issue fixes it): unit square, A = 2, lambda = 0.1, P0 = 9
 // (p0 = 3), the left side drained to p = 1, backward Euler, Newton.
-// Usage: seepage-benchmark [cells per side ...]   (default 99 315 999: 1e4..1e6 unknowns)
+// Usage: seepage-benchmark [cells per side ...]   (default 99 315 999: 1e4..1e6 unknowns; --help)
 #include <chrono>
 #include <cstdio>
-#include <cstdlib>
 #include <vector>
 
+#include <CLI/CLI.hpp>
 #include <Eigen/CholmodSupport>
 
 #include "common/blas.hpp"
@@ -46,9 +46,18 @@ double bare_factor_and_solve(const Eigen::SparseMatrix<double>& j, int mode, int
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::vector<int> sides;
-  for (int i = 1; i < argc; ++i) sides.push_back(std::atoi(argv[i]));
-  if (sides.empty()) sides = {99, 315, 999};
+  CLI::App app("Where the time of a seepage step goes, beside a bare CHOLMOD factor-and-solve of the same Jacobian",
+               "seepage-benchmark");
+  std::vector<int> sides{99, 315, 999};
+  app.add_option("cells", sides, "cells per side of the unit square, one row each (unknowns: (n + 1)^2)")
+      ->check(CLI::Range(2, 4000))
+      ->capture_default_str();
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // --help is a success; anything else is a bad command line (exit code 2, as every program here).
+    return app.exit(e) == 0 ? 0 : 2;
+  }
   std::printf("BLAS: %s\n\n", blas::description().c_str());
   std::printf("%9s %7s %9s %9s %9s %9s %9s %9s %7s %10s %10s %12s\n", "unknowns", "mode", "step[s]",
               "newton[s]", "factor[s]", "solve[s]", "other[s]", "bare[s]", "other/", "assembly",
