@@ -38,6 +38,7 @@ inline constexpr Dimension area{2, 0, 0, 0};
 inline constexpr Dimension viscosity{-1, 1, -1, 0};
 inline constexpr Dimension rate{0, 0, -1, 0};  // 1/s
 inline constexpr Dimension force_per_length{0, 1, -2, 0};  // N/m: a 2D model's force per metre of depth
+inline constexpr Dimension energy_per_area = force_per_length;  // J/m2 = N/m: a fracture energy
 // lambda in q = -lambda grad(p^2): m^2 / (Pa^2 s)
 inline constexpr Dimension gas_conductivity{4, -2, 3, 0};
 // k / mu in q = -(k / mu) grad(p): m^2 / (Pa s)

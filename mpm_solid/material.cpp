@@ -2,7 +2,11 @@
 
 #include <cmath>
 #include <algorithm>
+#include <limits>
+#include <stdexcept>
 #include <tuple>
+
+#include <fmt/format.h>
 
 namespace outburst::mpm {
 
@@ -199,8 +203,26 @@ double crack(double principal_value, double factor) {
 
 }  // namespace
 
+double largest_band_width(const DamageParameters& d, const Elasticity& e) {
+  return d.fracture_energy ? 2 * e.youngs_modulus * *d.fracture_energy / (d.tensile_strength * d.tensile_strength)
+                           : std::numeric_limits<double>::infinity();
+}
+
 ElasticDamage::ElasticDamage(std::string name, Elasticity elasticity, DamageParameters damage)
     : Material(std::move(name), elasticity), parameters_(damage) {
+  const double eps_t0 = damage.tensile_strength / elasticity.youngs_modulus;
+  if (!damage.fracture_energy) {
+    ultimate_strain_ = damage.ultimate_ratio * eps_t0;
+  } else {
+    if (!(damage.band_width > 0 && damage.band_width <= largest_band_width(damage, elasticity) &&
+          damage.residual_ratio > 0))
+      throw std::invalid_argument(fmt::format(
+          "material \"{}\": a crack band of {:g} m with G_f = {:g} J/m2 and a residual ratio of {:g} cannot hold",
+          this->name(), damage.band_width, *damage.fracture_energy, damage.residual_ratio));
+    const double per_volume = *damage.fracture_energy / damage.band_width;
+    ultimate_strain_ =
+        eps_t0 + (per_volume - 0.5 * damage.tensile_strength * eps_t0) / (damage.residual_ratio * damage.tensile_strength);
+  }
   std::tie(alpha_, k0_) =
       DruckerPragerFit::coefficients(DruckerPragerFit::Kind::outer, damage.cohesion, damage.friction_angle);
   sin_phi_ = std::sin(damage.friction_angle);
@@ -219,7 +241,7 @@ double ElasticDamage::damage(double previous, const Mat<2>& effective, double ef
   if (s1 >= d.tensile_strength) {
     const double eps1 = strain(s1, s2, s3), eps_t0 = d.tensile_strength / e0;
     const double tensile =
-        eps1 >= d.ultimate_ratio * eps_t0 ? 1.0 : 1 - d.residual_ratio * d.tensile_strength / (e0 * eps1);
+        eps1 >= ultimate_strain_ ? 1.0 : 1 - d.residual_ratio * d.tensile_strength / (e0 * eps1);
     damage = std::max(damage, tensile);
   }
   if (0.5 * (s1 - s3) >= d.cohesion * cos_phi_ - 0.5 * (s1 + s3) * sin_phi_) {

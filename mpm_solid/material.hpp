@@ -4,6 +4,7 @@
 // and step, never per particle, so the particle loop has no virtual call.
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -138,7 +139,15 @@ struct DamageParameters {
   double friction_angle;    // phi [rad]
   double tensile_strength;  // f_t [Pa]
   double residual_ratio;    // f_tr / f_t = f_cr / f_c
-  double ultimate_ratio;    // eta = eps_tu / eps_t0
+  double ultimate_ratio;    // eta = eps_tu / eps_t0, unless a fracture energy is given
+  // Crack band: with a fracture energy G_f [J/m2] the ultimate tensile strain
+  // is set so that a band band_width [m] wide dissipates G_f per unit crack
+  // area, whatever the resolution: band_width times the area under the
+  // softening law, f_t eps_t0 / 2 + f_tr (eps_tu - eps_t0), equals G_f. A band
+  // too wide for that (the peak alone would dissipate more) is refused when
+  // the scene is read (largest_band_width).
+  std::optional<double> fracture_energy;
+  double band_width = 0;
   // Largest volume of fully damaged material over its initial volume. Broken
   // coal bulks to a loose heap; beyond that its fragments part and the gaps are
   // no part of any particle. Without the cap a fragment's volume grows with
@@ -146,6 +155,10 @@ struct DamageParameters {
   // recontact) with it, and the stable step shrinks without bound.
   double bulking_factor = 1.5;
 };
+
+// The widest crack band a fracture energy allows with elasticity e: the one
+// whose peak alone, f_t^2 / (2 E0) per unit volume, dissipates G_f [m].
+double largest_band_width(const DamageParameters& d, const Elasticity& e);
 
 class ElasticDamage final : public Material {
  public:
@@ -162,7 +175,8 @@ class ElasticDamage final : public Material {
 
  private:
   DamageParameters parameters_;
-  double alpha_, k0_;  // Drucker-Prager friction cone (outer fit), intact cohesion
+  double ultimate_strain_;  // eps_tu: from eta, or from G_f and the band width
+  double alpha_, k0_;       // Drucker-Prager friction cone (outer fit), intact cohesion
   double sin_phi_, cos_phi_, ucs_;  // of the Mohr-Coulomb shear criterion
 };
 

@@ -57,7 +57,7 @@ void read_obstacles(const scene::Table& s, Settings& st, const Grid<2>& grid) {
 
 void read_platens(const scene::Table& s, Settings& st, const Grid<2>& grid) {
   for (const auto& t : s.table_array("platens", "rigid, massless, frictionless loading plates: the grid nodes in "
-                                                "the box move together along the force")) {
+                                                "the box move together along its axis")) {
     const auto lo = t.quantity_vector({"box_min", "lower-left corner of the box of grid nodes the plate holds"},
                                       units::length, 2);
     const auto hi = t.quantity_vector({"box_max", "upper-right corner of that box"}, units::length, 2);
@@ -76,10 +76,18 @@ void read_platens(const scene::Table& s, Settings& st, const Grid<2>& grid) {
     }
     const int axis =
         t.choice<int>({"direction", "the axis the plate moves along: \"x\" or \"y\""}, {{"x", 0}, {"y", 1}});
-    const double force = t.quantity({"force", "load on the plate along that axis per metre of depth (negative: "
-                                              "toward smaller coordinates)"},
-                                    units::force_per_length);
-    st.platens.push_back({lov, hiv, axis, force});
+    Platen platen{lov, hiv, axis};
+    if (t.has("velocity")) {
+      if (t.has("force")) t.fail("force", "give the plate a force or a velocity, not both");
+      platen.velocity = t.quantity({"velocity", "speed of a displacement-controlled plate along that axis, whatever "
+                                                "force it takes (negative: toward smaller coordinates)"},
+                                   units::velocity);
+    } else {
+      platen.force = t.quantity({"force", "load on the plate along that axis per metre of depth (negative: toward "
+                                          "smaller coordinates); or give a velocity"},
+                                units::force_per_length);
+    }
+    st.platens.push_back(platen);
   }
 }
 
@@ -288,9 +296,32 @@ Setup read_setup(const scene::Table& s) {
       d.residual_ratio = m.number({"residual_ratio", "residual strength / strength, in tension and compression "
                                                      "(the paper gives none; 0.1 is common for RFPA models)",
                                    "0.1", Range{0.0, 1.0, true, false}});
-      d.ultimate_ratio = m.number({"ultimate_strain_ratio", "eta = ultimate tensile strain / strain at f_t, beyond "
-                                                            "which D = 1 (the paper gives none; 5-10 is common)",
-                                   "5", Range::at_least(1)});
+      if (m.has("fracture_energy")) {
+        // Crack band: the ultimate strain follows from G_f and the grid's cell,
+        // the narrowest band the grid's velocity field can open.
+        if (m.has("ultimate_strain_ratio"))
+          m.fail("ultimate_strain_ratio", "give the ultimate strain ratio (the paper's local law) or a "
+                                          "fracture_energy (a crack band), not both");
+        d.fracture_energy = m.quantity({"fracture_energy", "G_f, energy per unit crack area dissipated in tension: "
+                                                           "a crack band one grid cell wide softens so that it "
+                                                           "dissipates G_f whatever the cell size (K_Ic^2 / E)",
+                                        "", Range::positive()},
+                                       units::energy_per_area);
+        d.band_width = setup.grid.h;
+        if (d.residual_ratio == 0)
+          m.fail("residual_ratio", "a crack band softens along the residual strength: give residual_ratio > 0");
+        if (const double widest = largest_band_width(d, e); d.band_width > widest)
+          m.refuse("fracture_energy",
+                   fmt::format("cells of {:g} m are too coarse for a crack band with G_f = {:g} J/m2: the peak alone, "
+                               "f_t^2 / (2 E), would dissipate more in a cell than G_f allows; refine "
+                               "mpm.grid.cell_size to at most 2 E G_f / f_t^2 = {:.4g} m, or raise G_f",
+                               d.band_width, *d.fracture_energy, widest));
+      } else {
+        d.ultimate_ratio = m.number({"ultimate_strain_ratio", "eta = ultimate tensile strain / strain at f_t, beyond "
+                                                              "which D = 1 (the paper gives none; 5-10 is common); "
+                                                              "or give a fracture_energy",
+                                     "5", Range::at_least(1)});
+      }
       d.bulking_factor = m.number({"bulking_factor", "largest volume of fully damaged coal over its volume at t = 0: "
                                                      "broken coal bulks to a loose heap, its fragments then part "
                                                      "(1.3-1.6 is typical of broken coal)",

@@ -133,6 +133,7 @@ Solver::Solver(Grid<2> grid, std::vector<std::unique_ptr<Material>> materials,
     if (nodes.empty()) throw std::invalid_argument("a platen's box holds no grid node");
   }
   platen_displacement_.assign(settings_.platens.size(), 0.0);
+  platen_force_.assign(settings_.platens.size(), 0.0);
   for (const auto& m : materials_) wave_speed_squared_.push_back(std::pow(m->elasticity().p_wave_speed(), 2));
 
   // One kernel per (shape, scheme), chosen here once.
@@ -245,7 +246,8 @@ void Solver::grid_velocities() {
 }
 
 // A massless plate moves with the momentum of the nodes it holds plus its
-// force's impulse, shared over their mass; it moves them all with it.
+// force's impulse, shared over their mass, or at its set speed, with the force
+// that takes; it moves them all with it.
 void Solver::apply_platens(std::vector<Vec<2>>& velocity, double impulse, double dt) {
   for (std::size_t k = 0; k < platen_nodes_.size(); ++k) {
     const Platen& platen = settings_.platens[k];
@@ -256,11 +258,13 @@ void Solver::apply_platens(std::vector<Vec<2>>& velocity, double impulse, double
         momentum += mass_[i] * velocity[i][platen.axis];
       }
     if (mass == 0) continue;
-    const double v = (momentum + impulse * platen.force) / mass;
+    const double v = platen.velocity ? *platen.velocity : (momentum + impulse * platen.force) / mass;
     for (std::size_t i : platen_nodes_[k])
       if (mass_[i] > empty_node_mass_) velocity[i][platen.axis] = v;
+    if (dt == 0) continue;  // the step's start: no force has acted yet
+    platen_force_[k] = platen.velocity ? (mass * v - momentum) / dt : platen.force;
     platen_displacement_[k] += v * dt;
-    dissipated_.external += platen.force * v * dt;
+    dissipated_.external += platen_force_[k] * v * dt;
   }
 }
 

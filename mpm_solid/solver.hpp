@@ -55,6 +55,10 @@ struct Platen {
   Vec<2> lower, upper;
   int axis = 1;
   double force = 0;  // along axis, per metre of depth [N/m]
+  // Set: the plate moves at this speed along axis [m/s] whatever it takes
+  // (displacement control, which can follow a load past its peak); `force`
+  // is then unused.
+  std::optional<double> velocity;
 };
 
 // The quasi-static stage before t = 0: in-situ stress and gravity brought to
@@ -221,6 +225,10 @@ class Solver {
 
   // How far each platen has moved along its axis since t = 0 [m].
   const std::vector<double>& platen_displacement() const { return platen_displacement_; }
+  // The force each platen exerted on the material in the last step, along its
+  // axis, per metre of depth [N/m]: its load, or the reaction of a plate moved
+  // at a set speed.
+  const std::vector<double>& platen_force() const { return platen_force_; }
 
   Energies energies() const;
   double kinetic_energy() const;  // the part of energies() a settling stage watches [J/m]
@@ -279,6 +287,7 @@ class Solver {
   std::vector<ObstacleNode> obstacle_nodes_;
   std::vector<std::vector<std::size_t>> platen_nodes_;  // the nodes each platen holds
   std::vector<double> platen_displacement_;
+  std::vector<double> platen_force_;
   Census census_;  // of the last step's move
 
   double time_ = 0;

@@ -112,7 +112,7 @@ TEST_CASE("Drucker-Prager below the yield surface is elastic", "[mpm][material]"
 
 namespace {
 
-const DamageParameters coal_damage{1e6, 30 * deg, 0.2e6, 0.1, 5.0};
+const DamageParameters coal_damage{1e6, 30 * deg, 0.2e6, 0.1, 5.0, std::nullopt};
 
 }  // namespace
 

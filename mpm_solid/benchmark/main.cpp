@@ -92,7 +92,7 @@ double particle_steps_per_second(long particles, ShapeKind shape, Model model, i
       break;
     case Model::elastic_damage:
       // Weak enough that the block damages as it lands.
-      materials.push_back(std::make_unique<ElasticDamage>("coal", e, DamageParameters{2e4, 0.5, 2e3, 0.1, 5}));
+      materials.push_back(std::make_unique<ElasticDamage>("coal", e, DamageParameters{2e4, 0.5, 2e3, 0.1, 5, std::nullopt}));
       break;
   }
   Settings s;
