@@ -26,6 +26,11 @@ std::filesystem::path RunOptions::output_directory() const {
 
 bool RunOptions::show_progress() const { return !quiet && stderr_is_terminal(); }
 
+OutputFolder::Earlier RunOptions::earlier_files() const {
+  return restart ? OutputFolder::Earlier::restart
+                 : overwrite ? OutputFolder::Earlier::overwrite : OutputFolder::Earlier::refuse;
+}
+
 output::RunInfo run_info(const std::string& program, const scene::Document& doc,
                          const std::string& units) {
   return {program,
@@ -61,6 +66,22 @@ SceneHeader read_scene_header(const scene::Table& root) {
     limits::refuse_count(*o, "interval", h.end_time / h.output_interval, limits::max_snapshots, "snapshots",
                          fmt::format("end_time {:.3g} s / interval {:.3g} s, a file each; lengthen the interval",
                                      h.end_time, h.output_interval));
+  }
+  h.checkpoint_interval = h.output_interval;
+  if (o && o->has("checkpoint_interval")) {
+    h.checkpoint_interval = o->quantity({"checkpoint_interval",
+                                         "simulated time between checkpoints, from which --restart continues a "
+                                         "stopped run (default: the output interval, a checkpoint with each "
+                                         "snapshot)",
+                                         "", scene::Range::positive()},
+                                        units::time);
+    // Each checkpoint rewrites one file, the run's whole state: not a count
+    // of files, but of full writes.
+    limits::refuse_count(*o, "checkpoint_interval", h.end_time / h.checkpoint_interval, limits::max_snapshots,
+                         "checkpoints",
+                         fmt::format("end_time {:.3g} s / checkpoint_interval {:.3g} s, the whole state each; "
+                                     "lengthen the interval",
+                                     h.end_time, h.checkpoint_interval));
   }
   return h;
 }
@@ -116,8 +137,12 @@ int run_program(const std::string& program, const std::string& description, int 
                  "Override a scene key: dotted.key=<TOML value>, e.g. "
                  "--set seepage.time_step='\"30 min\"'");
   app.add_flag("--check", options.check_only, "Validate the scene and stop");
-  app.add_flag("--overwrite", options.overwrite,
-               "Replace the files of an earlier run in the output folder (otherwise such a folder is refused)");
+  auto* overwrite = app.add_flag("--overwrite", options.overwrite,
+                                 "Replace the files of an earlier run in the output folder (otherwise such a folder "
+                                 "is refused)");
+  app.add_flag("--restart", options.restart,
+               "Continue the output folder's run from its last checkpoint (same scene, overrides and build)")
+      ->excludes(overwrite);
   app.add_flag("--explain", options.explain,
                "Print every key the scene uses with its value, default and meaning");
   app.add_flag("-q,--quiet", options.quiet, "No progress line");

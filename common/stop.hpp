@@ -1,8 +1,8 @@
 #pragma once
 // Stopping a run on request. SIGINT or SIGTERM only sets a flag (async-signal
 // safe); each program's run loop checks it after every step (or coupling
-// window), writes a snapshot of the state it reached, says so and exits with
-// exit_stopped. The histories are flushed line by line anyway. A second
+// window), writes a snapshot and a checkpoint of the state it reached, says
+// so and exits with exit_stopped. The histories are flushed line by line anyway. A second
 // signal ends the process at once, as the signal would by default.
 
 #include <filesystem>
@@ -17,7 +17,7 @@ void install_stop_handlers();
 bool stop_requested();
 
 // Logs that the run stopped at `time` [s] with its last snapshot listed in
-// `index`; returns exit_stopped.
+// `index` (and its checkpoint written); returns exit_stopped.
 int report_stop(double time, const std::filesystem::path& index);
 
 }  // namespace outburst

@@ -40,7 +40,9 @@ std::vector<stability::Regime> poroelastic_regimes(const CoupledSetup& setup);
 
 class CoupledModel {
  public:
-  explicit CoupledModel(CoupledSetup setup);
+  // `restarting`: a checkpoint will restore the state (load), so the solid's
+  // settling stage is skipped.
+  explicit CoupledModel(CoupledSetup setup, bool restarting = false);
 
   // One coupling window, cut short at `limit`.
   const WindowRecord& advance(double limit);
@@ -52,6 +54,11 @@ class CoupledModel {
   const SeepageParticipant& seepage_side() const { return *seepage_side_; }
   const SolidParticipant& solid_side() const { return *solid_side_; }
   const Coupling& coupling() const { return *coupling_; }
+  // Both solvers, both participants and the coupling, to and from a
+  // checkpoint taken between windows.
+  void save(checkpoint::Out out) const;
+  void load(const checkpoint::In& in);
+
   // Kinetic energy left by the settling stage over its peak (nullopt: no stage).
   std::optional<double> settled() const { return settled_; }
 

@@ -125,6 +125,8 @@ struct Energies {
   double total() const {
     return kinetic + strain + gravity + plastic + damage + damping + walls + transfer + left - external;
   }
+  void save(checkpoint::Out out, const std::string& name) const;
+  static Energies load(const checkpoint::In& in, const std::string& name);
 };
 
 // Whether a run's energy books close: over the states recorded, the largest
@@ -139,6 +141,8 @@ class EnergyAudit {
   double final_share() const { return largest_term_ > 0 ? last_error_ / largest_term_ : 0.0; }
   double largest_term() const { return largest_term_; }
   double worst_time() const { return worst_time_; }
+  void save(checkpoint::Out out) const;
+  void load(const checkpoint::In& in);
 
  private:
   std::optional<Energies> first_;
@@ -212,6 +216,11 @@ class Solver {
   };
   State save_state() const { return {time_, steps_, removed_, particles_, dissipated_, platen_displacement_}; }
   void restore_state(const State& s);
+  // The state to and from a checkpoint (a run continued by --restart). A
+  // checkpoint of the dynamic stage removes the supports as settle() did; the
+  // stage itself need not run again.
+  void save(checkpoint::Out out) const;
+  void load(const checkpoint::In& in);
 
   // Runs the quasi-static stage (steps of `fixed_step` or the CFL step), then
   // starts the dynamic one: supports removed, material at rest, clock and
@@ -243,6 +252,7 @@ class Solver {
   double apply_walls(std::vector<Vec<2>>& velocity) const;
   void apply_platens(std::vector<Vec<2>>& velocity, double impulse, double dt);
   void find_obstacle_nodes();
+  void remove_supports();  // the settling stage is over
   void fold_ghosts(std::vector<double>* mass, std::vector<Vec<2>>& vectors) const;
   void update_stresses(double dt);
   void count(int i, double dt, Census& census) const;
@@ -285,6 +295,7 @@ class Solver {
   long steps_ = 0;
   std::size_t removed_ = 0;
   Energies dissipated_;  // only the accumulated members are used
+  bool settled_ = false;  // a settling stage ran: its supports are gone
 };
 
 }  // namespace outburst::mpm

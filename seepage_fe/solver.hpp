@@ -20,6 +20,7 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
+#include "common/checkpoint.hpp"
 #include "seepage_fe/cell_locator.hpp"
 #include "seepage_fe/mesh.hpp"
 #include "seepage_fe/model.hpp"
@@ -120,6 +121,9 @@ class Solver {
   };
   State save_state() const;
   void restore_state(const State& state);
+  // The state to and from a checkpoint (a run continued by --restart).
+  void save(checkpoint::Out out) const;
+  void load(const checkpoint::In& in);
 
   // ---- results
   const Mesh& mesh() const { return mesh_; }
