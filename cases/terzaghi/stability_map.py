@@ -172,7 +172,8 @@ def plot(predicted, measured, windows, sms, path):
                 [[consolidation(alpha, sm) / CELL ** 2] for sm in sms])
             y = np.outer(sms, np.ones_like(windows))
             mesh = ax.pcolormesh(x, y, grid, cmap="RdBu_r", norm=norm, shading="gouraud")
-            ax.contour(x, y, grid, levels=[0], colors="k", linewidths=1)
+            if np.nanmax(grid) > 0 > np.nanmin(grid):
+                ax.contour(x, y, grid, levels=[0], colors="k", linewidths=1)
             for r in measured:
                 if r["biot"] != alpha or r["scheme"] != label:
                     continue
