@@ -23,6 +23,8 @@ std::string joined(const std::vector<std::string>& lines) {
   throw scene::Error(fmt::format("--restart: {}: {}", file.string(), why));
 }
 
+const char* stage_name(Stage stage) { return stage == Stage::settling ? "settling" : "run"; }
+
 }  // namespace
 
 void Out::number(const std::string& name, double value) const { file_->write(path_ + "/" + name, &value, {1}); }
@@ -102,9 +104,11 @@ void cut_back(const In& in, const std::string& name, const std::filesystem::path
   if (!stream) in.fail(name, fmt::format("cannot open {} to append to it", file.string()));
 }
 
-Writer::Writer(const std::filesystem::path& directory, const output::RunInfo& info) : file_(directory / file_name) {
+Writer::Writer(const std::filesystem::path& directory, const output::RunInfo& info, Stage stage)
+    : file_(directory / file_name) {
   file_.attribute("/", "program", info.program);
   file_.attribute("/", "version", info.version);
+  file_.attribute("/", "stage", stage_name(stage));
   file_.attribute("/", "scene_file", info.scene_file);
   file_.attribute("/", "scene_text", info.scene_text);
   file_.attribute("/", "scene_overrides", joined(info.overrides));
@@ -143,6 +147,10 @@ Reader::Reader(const std::filesystem::path& directory, const output::RunInfo& in
   if (const auto overrides = attribute("scene_overrides"); overrides != joined(info.overrides))
     refuse(fmt::format("written with other --set overrides: [{}]; give the same ones",
                        overrides.empty() ? "none" : overrides.substr(0, overrides.size() - 1)));
+  if (const auto stage = attribute("stage"); stage == stage_name(Stage::settling))
+    stage_ = Stage::settling;
+  else if (stage != stage_name(Stage::run))
+    refuse(fmt::format("unknown stage '{}'", stage));
   const int threads = static_cast<int>(file_->number_attribute("/", "threads"));
   if (threads != omp_get_max_threads())
     spdlog::warn("--restart: the checkpoint was written with {} threads, this run has {}: the run continues "

@@ -9,6 +9,9 @@
 // is the value written, bit for bit. A checkpoint records the program, its
 // version, the scene text and the overrides; a restart by another program or
 // build, or with another scene, is refused (scene::Error: exit code 2).
+//
+// A checkpoint holds one of two stages: the settling stage of an MPM solid
+// (before t = 0, no output written yet), or the run itself.
 
 #include <concepts>
 #include <cstdint>
@@ -28,6 +31,8 @@ namespace outburst::checkpoint {
 
 // The file name in the output folder.
 inline constexpr const char* file_name = "checkpoint.h5";
+
+enum class Stage { settling, run };
 
 // One group of a checkpoint being written ("/seepage/balance").
 class Out {
@@ -104,10 +109,11 @@ class In {
 void save_length(Out out, const std::string& name, const std::filesystem::path& file);
 void cut_back(const In& in, const std::string& name, const std::filesystem::path& file, std::ofstream& stream);
 
-// A checkpoint being written: provenance on its root, state in groups.
+// A checkpoint being written: provenance and stage on its root, state in
+// groups.
 class Writer {
  public:
-  Writer(const std::filesystem::path& directory, const output::RunInfo& info);
+  Writer(const std::filesystem::path& directory, const output::RunInfo& info, Stage stage);
   Out root() { return {file_, ""}; }
   // Replaces the folder's checkpoint with this one.
   void commit() { file_.commit(); }
@@ -124,10 +130,12 @@ class Reader {
   Reader(const std::filesystem::path& directory, const output::RunInfo& info);
   In root() const { return {*file_, path_, ""}; }
   const std::filesystem::path& path() const { return path_; }
+  Stage stage() const { return stage_; }
 
  private:
   std::filesystem::path path_;
   std::unique_ptr<hdf5::H5Reader> file_;
+  Stage stage_ = Stage::run;
 };
 
 }  // namespace outburst::checkpoint

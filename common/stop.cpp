@@ -43,4 +43,12 @@ int report_stop(double time, const std::filesystem::path& index) {
   return exit_stopped;
 }
 
+int report_settling_stop(double time, double duration, const std::filesystem::path& checkpoint) {
+  spdlog::warn("stopped by {} while settling, at {:.9g} s of the {:.9g} s stage (before t = 0: no snapshot yet): "
+               "the state there is the checkpoint {}, which --restart continues from",
+               requested == SIGINT ? "SIGINT" : "SIGTERM", time, duration,
+               std::filesystem::absolute(checkpoint).string());
+  return exit_stopped;
+}
+
 }  // namespace outburst

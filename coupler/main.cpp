@@ -75,21 +75,47 @@ int run(const RunOptions& options, scene::Document& doc) {
                                               "are effective (total = effective - alpha p I)");
   std::optional<checkpoint::Reader> restart;
   if (options.restart) restart.emplace(directory, info);
+  // A checkpoint of the settling stage continues it; the run then starts as
+  // a fresh one would, outputs and all.
+  const bool resume_run = restart && restart->stage() == checkpoint::Stage::run;
   const SceneHeader header = setup.header;
   const auto tracers = setup.solid.tracers;
-  coupling::CoupledModel model(std::move(setup), options.restart);
-  if (const auto left = model.settled())
+  const mpm::Settling settling = setup.solid.settling;
+  coupling::CoupledModel model(std::move(setup), /*settle_later=*/true);
+  if (settling.duration > 0 && !resume_run) {
+    CheckpointClock checkpoints(header.checkpoint_interval);
+    if (restart) {
+      const auto root = restart->root();
+      model.load(root.group("model"));
+      checkpoints.load(root.group("settling").group("checkpoints"));
+      spdlog::info("restarted from {} while settling, at {:.9g} s of the {:.9g} s stage", restart->path().string(),
+                   model.solid().time(), settling.duration);
+    }
+    const auto pause = [&] {
+      const bool stop = stop_requested();
+      if (checkpoints.due(model.solid().time()) || stop) {
+        checkpoint::Writer file(directory, info, checkpoint::Stage::settling);
+        auto root = file.root();
+        model.save(root.group("model"));
+        checkpoints.save(root.group("settling").group("checkpoints"));
+        file.commit();
+      }
+      return stop;
+    };
+    if (!model.settle(pause))
+      return report_settling_stop(model.solid().time(), settling.duration, directory / checkpoint::file_name);
     spdlog::info("settled for {:.3g} s: kinetic energy down to {:.2e} of its peak; supports removed",
-                 model.setup().solid.settling.duration, *left);
+                 settling.duration, *model.settled());
+  }
   auto& seepage_solver = model.seepage();
   auto& solid = model.solid();
   const auto& cs = model.setup().coupling;
   spdlog::info("{}: {} seepage cells, {} particles, window {:.3g} s", header.title, model.mapping().mesh().num_cells(),
                solid.particles().size(), cs.window);
 
-  seepage::Output seepage_out(directory, info, seepage_solver, options.restart);
-  mpm::Output solid_out(directory, info, tracers, options.restart);
-  WindowLog log(directory / "coupling.csv", cs.scheme.to_first, options.restart);
+  seepage::Output seepage_out(directory, info, seepage_solver, resume_run);
+  mpm::Output solid_out(directory, info, tracers, resume_run);
+  WindowLog log(directory / "coupling.csv", cs.scheme.to_first, resume_run);
   seepage_out.series().list_with_others();
   solid_out.series().list_with_others();
   const auto snapshot = [&] {
@@ -105,7 +131,7 @@ int run(const RunOptions& options, scene::Document& doc) {
   RestWatch rest(header.rest_fraction);
   CheckpointClock checkpoints(header.checkpoint_interval);
   const auto save_checkpoint = [&] {
-    checkpoint::Writer file(directory, info);
+    checkpoint::Writer file(directory, info, checkpoint::Stage::run);
     auto root = file.root();
     model.save(root.group("model"));
     seepage_out.save(root.group("seepage_output"));
@@ -118,7 +144,7 @@ int run(const RunOptions& options, scene::Document& doc) {
     checkpoints.save(run.group("checkpoints"));
     file.commit();
   };
-  if (restart) {
+  if (resume_run) {
     const auto root = restart->root();
     model.load(root.group("model"));
     seepage_out.load(root.group("seepage_output"));

@@ -4,6 +4,7 @@
 // coupling needs (total initial stresses made effective, then the solid's
 // settling stage). The `outburst` program and the tests build it alike.
 
+#include <functional>
 #include <memory>
 #include <optional>
 
@@ -40,9 +41,13 @@ std::vector<stability::Regime> poroelastic_regimes(const CoupledSetup& setup);
 
 class CoupledModel {
  public:
-  // `restarting`: a checkpoint will restore the state (load), so the solid's
-  // settling stage is skipped.
-  explicit CoupledModel(CoupledSetup setup, bool restarting = false);
+  // The solid's settling stage runs here, unless `settle_later`: then
+  // settle() runs it, or load() of a checkpoint of the run makes it needless.
+  explicit CoupledModel(CoupledSetup setup, bool settle_later = false);
+  // Runs the settling stage, or carries on with it after load() of a
+  // checkpoint taken during it; `pause` as for mpm::Solver::settle. False
+  // when paused.
+  bool settle(const std::function<bool()>& pause);
 
   // One coupling window, cut short at `limit`.
   const WindowRecord& advance(double limit);

@@ -40,20 +40,44 @@ int run(const RunOptions& options, scene::Document& doc) {
   const auto info = run_info("mpm-solid", doc, "SI: m, s, kg, Pa; 2D plane strain, per metre of depth");
   std::optional<checkpoint::Reader> restart;
   if (options.restart) restart.emplace(folder.path(), info);
+  // A checkpoint of the settling stage continues it; the run then starts as
+  // a fresh one would, outputs and all.
+  const bool resume_run = restart && restart->stage() == checkpoint::Stage::run;
 
   const auto wall_start = std::chrono::steady_clock::now();
-  if (setup.settling.duration > 0 && !restart) {
-    const double left = solver.settle(setup.settling, setup.fixed_time_step);
+  if (setup.settling.duration > 0 && !resume_run) {
+    CheckpointClock checkpoints(header.checkpoint_interval);
+    if (restart) {
+      const auto root = restart->root();
+      solver.load(root.group("mpm"));
+      checkpoints.load(root.group("settling").group("checkpoints"));
+      spdlog::info("restarted from {} while settling, at {:.9g} s of the {:.9g} s stage", restart->path().string(),
+                   solver.time(), setup.settling.duration);
+    }
+    const auto pause = [&] {
+      const bool stop = stop_requested();
+      if (checkpoints.due(solver.time()) || stop) {
+        checkpoint::Writer file(folder.path(), info, checkpoint::Stage::settling);
+        auto root = file.root();
+        solver.save(root.group("mpm"));
+        checkpoints.save(root.group("settling").group("checkpoints"));
+        file.commit();
+      }
+      return stop;
+    };
+    const auto left = solver.settle(setup.settling, setup.fixed_time_step, pause);
+    if (!left)
+      return report_settling_stop(solver.time(), setup.settling.duration, folder.path() / checkpoint::file_name);
     spdlog::info("settled for {:.3g} s: kinetic energy down to {:.2e} of its peak; supports removed",
-                 setup.settling.duration, left);
+                 setup.settling.duration, *left);
   }
-  mpm::Output out(folder.path(), info, setup.tracers, options.restart);
+  mpm::Output out(folder.path(), info, setup.tracers, resume_run);
   double last_snapshot_time = 0;
   double next_output = header.output_interval;
   RestWatch rest(header.rest_fraction);
   CheckpointClock checkpoints(header.checkpoint_interval);
   const auto save_checkpoint = [&] {
-    checkpoint::Writer file(folder.path(), info);
+    checkpoint::Writer file(folder.path(), info, checkpoint::Stage::run);
     auto root = file.root();
     solver.save(root.group("mpm"));
     out.save(root.group("output"));
@@ -64,7 +88,7 @@ int run(const RunOptions& options, scene::Document& doc) {
     checkpoints.save(run.group("checkpoints"));
     file.commit();
   };
-  if (restart) {
+  if (resume_run) {
     const auto root = restart->root();
     solver.load(root.group("mpm"));
     out.load(root.group("output"));

@@ -671,14 +671,19 @@ void Solver::shift_initial_stress(const std::vector<double>& per_particle) {
   }
 }
 
-double Solver::settle(const Settling& stage, std::optional<double> fixed_step) {
+std::optional<double> Solver::settle(const Settling& stage, std::optional<double> fixed_step,
+                                     const std::function<bool()>& pause) {
+  if (settled_) throw std::logic_error("settle: the settling stage is over");
   const double scene_damping = settings_.local_damping;
   settings_.local_damping = stage.damping;
-  double largest = 0, kinetic = 0;
   while (time_ < stage.duration * (1 - 1e-12)) {
     step(std::min(fixed_step ? *fixed_step : stable_time_step(), stage.duration - time_));
-    kinetic = kinetic_energy();
-    largest = std::max(largest, kinetic);
+    settling_kinetic_ = kinetic_energy();
+    settling_peak_ = std::max(settling_peak_, settling_kinetic_);
+    if (pause && pause()) {
+      settings_.local_damping = scene_damping;
+      return std::nullopt;
+    }
   }
   settings_.local_damping = scene_damping;
   remove_supports();
@@ -688,7 +693,7 @@ double Solver::settle(const Settling& stage, std::optional<double> fixed_step) {
   steps_ = 0;
   dissipated_ = {};
   std::fill(platen_displacement_.begin(), platen_displacement_.end(), 0.0);
-  return largest > 0 ? kinetic / largest : 0.0;
+  return settling_peak_ > 0 ? settling_kinetic_ / settling_peak_ : 0.0;
 }
 
 void Solver::save(checkpoint::Out out) const {
@@ -699,6 +704,7 @@ void Solver::save(checkpoint::Out out) const {
   dissipated_.save(out, "dissipated");
   out.numbers("platen_displacement", platen_displacement_);
   out.flag("settled", settled_);
+  out.numbers("settling_kinetic", std::vector<double>{settling_peak_, settling_kinetic_});
 }
 
 void Solver::load(const checkpoint::In& in) {
@@ -715,6 +721,9 @@ void Solver::load(const checkpoint::In& in) {
   removed_ = static_cast<std::size_t>(in.count("removed"));
   dissipated_ = Energies::load(in, "dissipated");
   platen_displacement_ = in.numbers("platen_displacement", settings_.platens.size());
+  const auto settling = in.numbers("settling_kinetic", 2);
+  settling_peak_ = settling[0];
+  settling_kinetic_ = settling[1];
   if (in.flag("settled") && !settled_) remove_supports();
 }
 

@@ -14,6 +14,7 @@
 // branch per particle.
 
 #include <array>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -216,9 +217,9 @@ class Solver {
   };
   State save_state() const { return {time_, steps_, removed_, particles_, dissipated_, platen_displacement_}; }
   void restore_state(const State& s);
-  // The state to and from a checkpoint (a run continued by --restart). A
-  // checkpoint of the dynamic stage removes the supports as settle() did; the
-  // stage itself need not run again.
+  // The state to and from a checkpoint (a run continued by --restart), the
+  // settling stage's progress included. A checkpoint of the dynamic stage
+  // removes the supports as settle() did; the stage need not run again.
   void save(checkpoint::Out out) const;
   void load(const checkpoint::In& in);
 
@@ -226,7 +227,12 @@ class Solver {
   // starts the dynamic one: supports removed, material at rest, clock and
   // energy books at zero, local damping back to the scene's. Returns the
   // kinetic energy left at the end of the stage, relative to its largest.
-  double settle(const Settling& stage, std::optional<double> fixed_step);
+  // `pause`, called after each step of the stage (time() is the stage's
+  // clock then), may stop it by returning true: settle() then returns
+  // nullopt, and called again, after load() of a checkpoint taken then if
+  // need be, carries on where it stopped.
+  std::optional<double> settle(const Settling& stage, std::optional<double> fixed_step,
+                               const std::function<bool()>& pause = {});
 
   // How far each platen has moved along its axis since t = 0 [m].
   const std::vector<double>& platen_displacement() const { return platen_displacement_; }
@@ -296,6 +302,8 @@ class Solver {
   std::size_t removed_ = 0;
   Energies dissipated_;  // only the accumulated members are used
   bool settled_ = false;  // a settling stage ran: its supports are gone
+  // Of the settling stage so far: the largest kinetic energy and the last [J/m].
+  double settling_peak_ = 0, settling_kinetic_ = 0;
 };
 
 }  // namespace outburst::mpm

@@ -45,7 +45,7 @@ int run(const RunOptions& options, scene::Document& doc) {
   long iterations = 0;
   CheckpointClock checkpoints(header.checkpoint_interval);
   const auto save_checkpoint = [&] {
-    checkpoint::Writer file(folder.path(), info);
+    checkpoint::Writer file(folder.path(), info, checkpoint::Stage::run);
     auto root = file.root();
     solver.save(root.group("seepage"));
     out.save(root.group("output"));
