@@ -25,7 +25,27 @@ std::string joined(const std::vector<std::string>& lines) {
 
 const char* stage_name(Stage stage) { return stage == Stage::settling ? "settling" : "run"; }
 
+// The version string names a commit, but not edits made since, nor the
+// compiler and flags: only the same program file computes bit for bit alike.
+std::string build_fingerprint() {
+  static const std::string fingerprint = [] {
+    std::ifstream program("/proc/self/exe", std::ios::binary);
+    if (!program) return std::string("unknown");
+    Fingerprint f;
+    std::vector<char> chunk(1 << 16);
+    while (program.read(chunk.data(), static_cast<std::streamsize>(chunk.size())) || program.gcount() > 0)
+      f.add(chunk.data(), static_cast<std::size_t>(program.gcount()));
+    return fmt::format("{:016x}", static_cast<std::uint64_t>(f.value()));
+  }();
+  return fingerprint;
+}
+
 }  // namespace
+
+void Fingerprint::add(const void* data, std::size_t bytes) {
+  const auto* byte = static_cast<const unsigned char*>(data);
+  for (std::size_t i = 0; i < bytes; ++i) hash_ = (hash_ ^ byte[i]) * 1099511628211ull;
+}
 
 void Out::number(const std::string& name, double value) const { file_->write(path_ + "/" + name, &value, {1}); }
 
@@ -48,6 +68,8 @@ void Out::write_counts(const std::string& name, const std::vector<std::int64_t>&
 void In::fail(const std::string& name, const std::string& what) const {
   throw std::runtime_error(fmt::format("checkpoint {}: {}/{}: {}", name_.string(), path_, name, what));
 }
+
+void In::refuse(const std::string& why) const { checkpoint::refuse(name_, why); }
 
 double In::number(const std::string& name) const {
   const auto v = numbers(name, 1);
@@ -108,6 +130,7 @@ Writer::Writer(const std::filesystem::path& directory, const output::RunInfo& in
     : file_(directory / file_name) {
   file_.attribute("/", "program", info.program);
   file_.attribute("/", "version", info.version);
+  file_.attribute("/", "build", build_fingerprint());
   file_.attribute("/", "stage", stage_name(stage));
   file_.attribute("/", "scene_file", info.scene_file);
   file_.attribute("/", "scene_text", info.scene_text);
@@ -139,6 +162,10 @@ Reader::Reader(const std::filesystem::path& directory, const output::RunInfo& in
   if (const auto version = attribute("version"); version != info.version)
     refuse(fmt::format("written by version {}, this is {}; finish the run with that build, or start afresh",
                        version, info.version));
+  if (attribute("build") != build_fingerprint())
+    refuse(fmt::format("written by another build of version {} (the program file differs: rebuilt since, or "
+                       "another build folder); finish the run with that build, or start afresh",
+                       info.version));
   // Any change, even of end_time alone, changes what the run computes: the
   // default output interval is end_time / 10, and so the steps that land on
   // output times.
@@ -154,7 +181,7 @@ Reader::Reader(const std::filesystem::path& directory, const output::RunInfo& in
   const int threads = static_cast<int>(file_->number_attribute("/", "threads"));
   if (threads != omp_get_max_threads())
     spdlog::warn("--restart: the checkpoint was written with {} threads, this run has {}: the run continues "
-                 "correctly, but not bit for bit as it would have with {} (README: checkpoints)",
+                 "correctly, but not bit for bit as it would have with {} (README.md, Checkpoints and restart)",
                  threads, omp_get_max_threads(), threads);
 }
 

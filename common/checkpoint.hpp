@@ -7,8 +7,9 @@
 // reads them back (load), so the knowledge of what a class must keep stays
 // with the class. Numbers are stored as 64-bit datasets, so a value read back
 // is the value written, bit for bit. A checkpoint records the program, its
-// version, the scene text and the overrides; a restart by another program or
-// build, or with another scene, is refused (scene::Error: exit code 2).
+// version and a fingerprint of its program file, the scene text and the
+// overrides; a restart by another program or build, or with another scene, is
+// refused (scene::Error: exit code 2).
 //
 // A checkpoint holds one of two stages: the settling stage of an MPM solid
 // (before t = 0, no output written yet), or the run itself.
@@ -33,6 +34,21 @@ namespace outburst::checkpoint {
 inline constexpr const char* file_name = "checkpoint.h5";
 
 enum class Stage { settling, run };
+
+// FNV-1a over bytes: a cheap identity for inputs a checkpoint must match (a
+// mesh file's content, the program file), not a defence against tampering.
+class Fingerprint {
+ public:
+  void add(const void* data, std::size_t bytes);
+  template <class T>
+  void add(const std::vector<T>& values) {
+    add(values.data(), values.size() * sizeof(T));
+  }
+  std::int64_t value() const { return static_cast<std::int64_t>(hash_); }
+
+ private:
+  std::uint64_t hash_ = 14695981039346656037ull;
+};
 
 // One group of a checkpoint being written ("/seepage/balance").
 class Out {
@@ -92,8 +108,11 @@ class In {
       values[i] = Eigen::Map<const Eigen::Matrix<double, R, C>>(flat.data() + i * R * C);
     return values;
   }
-  // A std::runtime_error naming the file and the dataset.
+  // A std::runtime_error naming the file and the dataset: a damaged checkpoint.
   [[noreturn]] void fail(const std::string& name, const std::string& what) const;
+  // A scene::Error (exit code 2) naming the file: a checkpoint of another
+  // input than this run's.
+  [[noreturn]] void refuse(const std::string& why) const;
 
  private:
   std::vector<std::int64_t> read_counts(const std::string& name, std::optional<std::size_t> size) const;

@@ -14,6 +14,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "common/checkpoint.hpp"
 #include "common/scene.hpp"
 
 namespace outburst {
@@ -47,6 +48,9 @@ OutputFolder::OutputFolder(std::filesystem::path directory, const std::string& p
   std::error_code error;
   if (std::filesystem::exists(directory_, error) && !std::filesystem::is_directory(directory_, error))
     refuse(directory_, "it exists and is not a folder; give a folder with -o");
+  if (earlier_files == Earlier::restart && !std::filesystem::exists(directory_, error))
+    refuse(directory_, "--restart: there is no such folder, so no run to continue; give the folder of the stopped "
+                       "run with -o, or run without --restart");
   std::filesystem::create_directories(directory_, error);
   if (error) refuse(directory_, fmt::format("cannot create it: {}", error.message()));
 
@@ -76,10 +80,13 @@ OutputFolder::OutputFolder(std::filesystem::path directory, const std::string& p
                                                           : written_by_a_run(name);
     if (remove) files.push_back(entry.path());
   }
-  if (!files.empty() && earlier_files == Earlier::refuse)
+  if (!files.empty() && earlier_files == Earlier::refuse) {
+    const bool resumable = std::filesystem::exists(directory_ / checkpoint::file_name, error);
     refuse(directory_, fmt::format("it holds the output of an earlier run ({}, {} files); pass --overwrite to "
-                                   "replace it, or choose another folder with -o",
-                                   earlier.empty() ? "of unknown origin" : earlier, files.size()));
+                                   "replace it, {}or choose another folder with -o",
+                                   earlier.empty() ? "of unknown origin" : earlier, files.size(),
+                                   resumable ? "--restart to continue it from its checkpoint, " : ""));
+  }
   for (const auto& f : files)
     if (!std::filesystem::remove(f, error) && error)
       refuse(directory_, fmt::format("cannot remove {} of the earlier run: {}", f.filename().string(), error.message()));

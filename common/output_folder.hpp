@@ -10,7 +10,7 @@
 // asked to overwrite them, which removes them first: otherwise an earlier
 // run's later snapshots would stay beside the new run's. A restart keeps them
 // (the run continues them from its checkpoint) but for the temporary files a
-// killed run left.
+// killed run left, and refuses a folder that does not exist.
 // Errors are scene::Error (bad command line: exit code 2).
 
 #include <filesystem>

@@ -522,7 +522,21 @@ Solver::State Solver::save_state() const {
           last_inflow_pressure_, last_inflow_flux_, fixed_by_, pressure_bc_slot_, open_pressure_};
 }
 
+// A mesh file may change under an unchanged scene text.
+std::int64_t Solver::mesh_fingerprint() const {
+  checkpoint::Fingerprint f;
+  f.add(mesh_.nodes);
+  f.add(mesh_.cells);
+  f.add(mesh_.cell_region);
+  for (const auto& b : mesh_.boundaries) {
+    f.add(b.name.data(), b.name.size());
+    f.add(b.edges);
+  }
+  return f.value();
+}
+
 void Solver::save(checkpoint::Out out) const {
+  out.count("mesh_fingerprint", mesh_fingerprint());
   out.number("time", time_);
   out.count("steps", steps_);
   out.numbers("u", u_);
@@ -546,6 +560,9 @@ void Solver::save(checkpoint::Out out) const {
 }
 
 void Solver::load(const checkpoint::In& in) {
+  if (in.count("mesh_fingerprint") != mesh_fingerprint())
+    in.refuse("written for another seepage mesh (the mesh file changed since); finish the run with that mesh, or "
+              "start afresh");
   const std::size_t nodes = mesh_.num_nodes();
   State s;
   s.time = in.number("time");

@@ -169,6 +169,7 @@ class Solver {
   std::vector<int> dirichlet_zero_;    // value indices zeroed in the Jacobian
   std::vector<int> dirichlet_diagonal_;
   void find_dirichlet_entries();
+  std::int64_t mesh_fingerprint() const;
   std::vector<int> boundary_fixed_by_;  // fixed_by_ as the scene's conditions alone set it
   double open_pressure_ = 0;
 
