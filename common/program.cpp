@@ -68,12 +68,14 @@ SceneHeader read_scene_header(const scene::Table& root) {
                                      h.end_time, h.output_interval));
   }
   h.checkpoint_interval = h.output_interval;
-  if (o && o->has("checkpoint_interval")) {
+  if (o) {
+    // Read even when absent, so that --explain lists it with its default.
+    const std::string every_snapshot = fmt::format("{:.17g} s", h.output_interval);
     h.checkpoint_interval = o->quantity({"checkpoint_interval",
-                                         "simulated time between checkpoints, from which --restart continues a "
-                                         "stopped run (default: the output interval, a checkpoint with each "
-                                         "snapshot)",
-                                         "", scene::Range::positive()},
+                                         "simulated time between checkpoints (the run's whole state in "
+                                         "checkpoint.h5), from which --restart continues a stopped run; a "
+                                         "settling stage counts its own time (default: the output interval)",
+                                         every_snapshot, scene::Range::positive()},
                                         units::time);
     // Each checkpoint rewrites one file, the run's whole state: not a count
     // of files, but of full writes.
@@ -141,7 +143,8 @@ int run_program(const std::string& program, const std::string& description, int 
                                  "Replace the files of an earlier run in the output folder (otherwise such a folder "
                                  "is refused)");
   app.add_flag("--restart", options.restart,
-               "Continue the output folder's run from its last checkpoint (same scene, overrides and build)")
+               "Continue the run in the output folder from its last checkpoint: give the scene, -o and --set of "
+               "the stopped run (and the same -j for a bit-identical result)")
       ->excludes(overwrite);
   app.add_flag("--explain", options.explain,
                "Print every key the scene uses with its value, default and meaning");
@@ -150,6 +153,16 @@ int run_program(const std::string& program, const std::string& description, int 
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
   app.add_option("-j,--threads", options.threads, "OpenMP threads (default: all cores)")->check(thread_count());
   app.set_version_flag("--version", std::string(version));
+  app.footer(fmt::format(
+      "Exit codes: 0 done; 1 the run failed; 2 bad scene or command line; 3 stopped by SIGINT or SIGTERM; 4 scene "
+      "refused as unworkable.\n\n"
+      "Restart: a run writes its whole state to DIR/checkpoint.h5 every [output] checkpoint_interval of simulated "
+      "time (default: with each snapshot) and when SIGINT or SIGTERM stops it. A run stopped so, killed or crashed "
+      "continues from there with its own command line plus --restart, e.g.\n"
+      "  {} SCENE -o DIR --set key=value --restart\n"
+      "and ends as it would have without the stop, bit for bit. It refuses (exit code 2) a folder without a "
+      "checkpoint, another scene text, mesh or --set, and another build.",
+      program));
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

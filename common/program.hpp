@@ -6,11 +6,12 @@
 //
 // Checkpoints (common/checkpoint.hpp): every program writes its complete state
 // to DIR/checkpoint.h5 every [output] checkpoint_interval of simulated time
-// (default: at every snapshot) and when a signal stops it. --restart continues
-// the run of DIR from that checkpoint, with the same scene, overrides and
-// build (otherwise exit code 2): the histories and indexes are cut back to the
-// checkpoint's time and go on from there, and the run ends as it would have
-// without the stop, bit for bit at the same thread count.
+// (default: at every snapshot; a settling stage by its own clock) and when a
+// signal stops it. --restart continues the run of DIR from that checkpoint,
+// with the same scene, overrides and build (otherwise exit code 2): the
+// histories and indexes are cut back to the checkpoint's time and go on from
+// there, and the run ends as it would have without the stop, bit for bit at
+// the same thread count.
 //
 // and the one place that turns exceptions into exit codes: 2 for a bad scene or
 // command line (with the file, line and key), 4 for a valid scene refused
