@@ -152,17 +152,23 @@ void FieldSeries::load(const checkpoint::In& in) {
       parts.push_back(text.substr(a, b - a));
     }
     const std::string& kind = parts[0];
-    if (kind == "S" && parts.size() == 3) {
-      written_.push_back({std::stod(parts[1]), parts[2], {}});
-      grid = nullptr;
-    } else if (kind == "G" && parts.size() == 3 && !written_.empty()) {
-      grid = &written_.back().grids[parts[1]];
-      grid->points = std::stoul(parts[2]);
-    } else if (kind == "F" && parts.size() == 4 && grid) {
-      grid->fields.push_back({parts[1], parts[2] == "node" ? Center::node : Center::cell, std::stoi(parts[3])});
-    } else {
-      in.fail("snapshots", fmt::format("cannot read the line '{}'", text.substr(start, end - start)));
+    bool read = true;
+    try {
+      if (kind == "S" && parts.size() == 3) {
+        written_.push_back({std::stod(parts[1]), parts[2], {}});
+        grid = nullptr;
+      } else if (kind == "G" && parts.size() == 3 && !written_.empty()) {
+        grid = &written_.back().grids[parts[1]];
+        grid->points = std::stoul(parts[2]);
+      } else if (kind == "F" && parts.size() == 4 && grid) {
+        grid->fields.push_back({parts[1], parts[2] == "node" ? Center::node : Center::cell, std::stoi(parts[3])});
+      } else {
+        read = false;
+      }
+    } catch (const std::logic_error&) {  // std::stod and kin: not a number, or out of range
+      read = false;
     }
+    if (!read) in.fail("snapshots", fmt::format("cannot read the line '{}'", text.substr(start, end - start)));
   }
   for (std::size_t k = written_.size();; ++k) {
     const auto later = directory_ / fmt::format("{}_{:06d}.h5", name_, k);

@@ -128,10 +128,6 @@ void IqnIls::end_window(bool converged) {
   w_.clear();
 }
 
-}  // namespace outburst::coupling
-
-namespace outburst::coupling {
-
 void IqnIls::save(checkpoint::Out out) const {
   out.count("windows", static_cast<std::int64_t>(past_v_.size()));
   for (std::size_t k = 0; k < past_v_.size(); ++k) {
