@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "common/atomic_file.hpp"
+#include "common/checkpoint.hpp"
 #include "common/hdf5_file.hpp"
 
 namespace outburst::output {
@@ -121,6 +122,60 @@ void publish(const std::vector<FieldSeries*>& series) {
     throw;
   }
   for (std::size_t k = 0; k < series.size(); ++k) move_into_place(temps[k], series[k]->index_path());
+}
+
+// One line per snapshot, grid and field, tab-separated:
+//   S <time> <file>, G <grid> <points>, F <field> <node|cell> <components>
+void FieldSeries::save(checkpoint::Out out) const {
+  if (!pending_.empty()) throw std::logic_error("a checkpoint with snapshots written but not listed");
+  std::string text;
+  for (const auto& w : written_) {
+    text += fmt::format("S\t{:.17g}\t{}\n", w.time, w.file);
+    for (const auto& [grid, data] : w.grids) {
+      text += fmt::format("G\t{}\t{}\n", grid, data.points);
+      for (const auto& f : data.fields)
+        text += fmt::format("F\t{}\t{}\t{}\n", f.name, f.center == Center::node ? "node" : "cell", f.components);
+    }
+  }
+  out.text("snapshots", text);
+}
+
+void FieldSeries::load(const checkpoint::In& in) {
+  written_.clear();
+  pending_.clear();
+  const std::string text = in.text("snapshots");
+  WrittenGrid* grid = nullptr;
+  for (std::size_t start = 0, end; (end = text.find('\n', start)) != std::string::npos; start = end + 1) {
+    std::vector<std::string> parts;
+    for (std::size_t a = start, b; a <= end; a = b + 1) {
+      b = std::min(text.find('\t', a), end);
+      parts.push_back(text.substr(a, b - a));
+    }
+    const std::string& kind = parts[0];
+    bool read = true;
+    try {
+      if (kind == "S" && parts.size() == 3) {
+        written_.push_back({std::stod(parts[1]), parts[2], {}});
+        grid = nullptr;
+      } else if (kind == "G" && parts.size() == 3 && !written_.empty()) {
+        grid = &written_.back().grids[parts[1]];
+        grid->points = std::stoul(parts[2]);
+      } else if (kind == "F" && parts.size() == 4 && grid) {
+        grid->fields.push_back({parts[1], parts[2] == "node" ? Center::node : Center::cell, std::stoi(parts[3])});
+      } else {
+        read = false;
+      }
+    } catch (const std::logic_error&) {  // std::stod and kin: not a number, or out of range
+      read = false;
+    }
+    if (!read) in.fail("snapshots", fmt::format("cannot read the line '{}'", text.substr(start, end - start)));
+  }
+  for (std::size_t k = written_.size();; ++k) {
+    const auto later = directory_ / fmt::format("{}_{:06d}.h5", name_, k);
+    std::error_code error;
+    if (!std::filesystem::remove(later, error)) break;
+  }
+  write_file_atomically(index_path(), index_text());
 }
 
 std::string FieldSeries::index_text() const {

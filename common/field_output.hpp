@@ -15,6 +15,11 @@
 #include <string>
 #include <vector>
 
+namespace outburst::checkpoint {
+class Out;
+class In;
+}  // namespace outburst::checkpoint
+
 namespace outburst::output {
 
 struct RunInfo {
@@ -73,6 +78,13 @@ class FieldSeries {
 
   std::filesystem::path index_path() const { return directory_ / (name_ + ".xdmf"); }
   std::size_t snapshots_written() const { return written_.size(); }
+
+  // The snapshots listed so far, to and from a checkpoint. load() lists
+  // exactly those in the index again and removes later snapshot files (a
+  // killed run's, written after its checkpoint), so that the series goes on
+  // from the checkpoint's time.
+  void save(checkpoint::Out out) const;
+  void load(const checkpoint::In& in);
 
   // Series written at the same output times (a coupled run's seepage and
   // particles): from now on a time is listed in their indexes only by

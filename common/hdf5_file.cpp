@@ -61,6 +61,9 @@ void write_dataset(hid_t file, const std::filesystem::path& name, const std::str
   Handle ds(H5Dcreate2(file, path.c_str(), file_type, space, lcpl, H5P_DEFAULT, H5P_DEFAULT),
             H5Dclose);
   if (!ds.valid()) fail(name, fmt::format("cannot create dataset {}", path));
+  std::size_t count = 1;
+  for (auto d : dims) count *= d;
+  if (count == 0) return;  // an empty dataset has nothing to write, and may come without a buffer
   if (H5Dwrite(ds, memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0)
     fail(name, fmt::format("cannot write dataset {}", path));
 }
@@ -92,6 +95,17 @@ void H5Writer::write(const std::string& path, const double* data,
 void H5Writer::write(const std::string& path, const std::int64_t* data,
                      const std::vector<std::size_t>& dims) {
   write_dataset(file_, final_path_, path, H5T_STD_I64LE, H5T_NATIVE_INT64, data, dims);
+}
+
+void H5Writer::write_text(const std::string& path, const std::string& text) {
+  Handle type(string_type(), H5Tclose);
+  const char* data = text.c_str();
+  Handle space(H5Screate(H5S_SCALAR), H5Sclose);
+  Handle lcpl(H5Pcreate(H5P_LINK_CREATE), H5Pclose);
+  H5Pset_create_intermediate_group(lcpl, 1);
+  Handle ds(H5Dcreate2(file_, path.c_str(), type, space, lcpl, H5P_DEFAULT, H5P_DEFAULT), H5Dclose);
+  if (!ds.valid() || H5Dwrite(ds, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, &data) < 0)
+    fail(final_path_, fmt::format("cannot write text dataset {}", path));
 }
 
 void H5Writer::attribute(const std::string& object, const std::string& name,
@@ -164,6 +178,7 @@ std::vector<double> H5Reader::read_doubles(const std::string& path) const {
   std::size_t n = 1;
   for (auto d : shape(path)) n *= d;
   std::vector<double> data(n);
+  if (n == 0) return data;
   Handle ds(H5Dopen2(file_, path.c_str(), H5P_DEFAULT), H5Dclose);
   if (H5Dread(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()) < 0)
     fail(path_, fmt::format("cannot read dataset {} as numbers", path));
@@ -174,10 +189,23 @@ std::vector<std::int64_t> H5Reader::read_integers(const std::string& path) const
   std::size_t n = 1;
   for (auto d : shape(path)) n *= d;
   std::vector<std::int64_t> data(n);
+  if (n == 0) return data;
   Handle ds(H5Dopen2(file_, path.c_str(), H5P_DEFAULT), H5Dclose);
   if (H5Dread(ds, H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()) < 0)
     fail(path_, fmt::format("cannot read dataset {} as integers", path));
   return data;
+}
+
+std::string H5Reader::read_text(const std::string& path) const {
+  Handle ds(H5Dopen2(file_, path.c_str(), H5P_DEFAULT), H5Dclose);
+  if (!ds.valid()) fail(path_, fmt::format("no dataset {}", path));
+  Handle type(string_type(), H5Tclose);
+  char* text = nullptr;
+  if (H5Dread(ds, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, &text) < 0 || !text)
+    fail(path_, fmt::format("cannot read dataset {} as text", path));
+  std::string value(text);
+  H5free_memory(text);
+  return value;
 }
 
 std::string H5Reader::string_attribute(const std::string& object, const std::string& name) const {

@@ -30,6 +30,8 @@ class H5Writer {
              const std::string& unit = {}) {
     write(path, data.data(), {data.size()}, unit);
   }
+  // A text dataset (one variable-length UTF-8 string).
+  void write_text(const std::string& path, const std::string& text);
   // String and number attributes on the root group ("/") or an existing object.
   void attribute(const std::string& object, const std::string& name, const std::string& value);
   void attribute(const std::string& object, const std::string& name, double value);
@@ -55,6 +57,7 @@ class H5Reader {
   std::vector<std::size_t> shape(const std::string& path) const;
   std::vector<double> read_doubles(const std::string& path) const;
   std::vector<std::int64_t> read_integers(const std::string& path) const;
+  std::string read_text(const std::string& path) const;
   std::string string_attribute(const std::string& object, const std::string& name) const;
   double number_attribute(const std::string& object, const std::string& name) const;
 

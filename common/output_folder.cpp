@@ -14,6 +14,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "common/checkpoint.hpp"
 #include "common/scene.hpp"
 
 namespace outburst {
@@ -42,11 +43,14 @@ std::string holder(int fd) {
 
 }  // namespace
 
-OutputFolder::OutputFolder(std::filesystem::path directory, const std::string& program, bool overwrite)
+OutputFolder::OutputFolder(std::filesystem::path directory, const std::string& program, Earlier earlier_files)
     : directory_(std::move(directory)) {
   std::error_code error;
   if (std::filesystem::exists(directory_, error) && !std::filesystem::is_directory(directory_, error))
     refuse(directory_, "it exists and is not a folder; give a folder with -o");
+  if (earlier_files == Earlier::restart && !std::filesystem::exists(directory_, error))
+    refuse(directory_, "--restart: there is no such folder, so no run to continue; give the folder of the stopped "
+                       "run with -o, or run without --restart");
   std::filesystem::create_directories(directory_, error);
   if (error) refuse(directory_, fmt::format("cannot create it: {}", error.message()));
 
@@ -70,17 +74,25 @@ OutputFolder::OutputFolder(std::filesystem::path directory, const std::string& p
   std::filesystem::directory_iterator entries(directory_, error);
   if (error) refuse(directory_, fmt::format("cannot list it: {}", error.message()));
   std::vector<std::filesystem::path> files;
-  for (const auto& entry : entries)
-    if (written_by_a_run(entry.path().filename().string())) files.push_back(entry.path());
-  if (!files.empty() && !overwrite)
+  for (const auto& entry : entries) {
+    const std::string name = entry.path().filename().string();
+    const bool remove = earlier_files == Earlier::restart ? name.find(".partial-") != std::string::npos
+                                                          : written_by_a_run(name);
+    if (remove) files.push_back(entry.path());
+  }
+  if (!files.empty() && earlier_files == Earlier::refuse) {
+    const bool resumable = std::filesystem::exists(directory_ / checkpoint::file_name, error);
     refuse(directory_, fmt::format("it holds the output of an earlier run ({}, {} files); pass --overwrite to "
-                                   "replace it, or choose another folder with -o",
-                                   earlier.empty() ? "of unknown origin" : earlier, files.size()));
+                                   "replace it, {}or choose another folder with -o",
+                                   earlier.empty() ? "of unknown origin" : earlier, files.size(),
+                                   resumable ? "--restart to continue it from its checkpoint, " : ""));
+  }
   for (const auto& f : files)
     if (!std::filesystem::remove(f, error) && error)
       refuse(directory_, fmt::format("cannot remove {} of the earlier run: {}", f.filename().string(), error.message()));
   if (!files.empty())
-    spdlog::info("removed the {} files of an earlier run ({}) from {}", files.size(),
+    spdlog::info("removed the {} {} of an earlier run ({}) from {}", files.size(),
+                 earlier_files == Earlier::restart ? "unfinished files" : "files",
                  earlier.empty() ? "of unknown origin" : earlier, directory_.string());
 
   const std::string record = fmt::format("{}, pid {}, started {:%Y-%m-%d %H:%M:%S}\n", program, ::getpid(),

@@ -8,7 +8,9 @@
 // A run into a folder holding an earlier run's files (the XDMF indexes and
 // HDF5 files, the history CSVs, temporary .partial- files) is refused unless
 // asked to overwrite them, which removes them first: otherwise an earlier
-// run's later snapshots would stay beside the new run's.
+// run's later snapshots would stay beside the new run's. A restart keeps them
+// (the run continues them from its checkpoint) but for the temporary files a
+// killed run left, and refuses a folder that does not exist.
 // Errors are scene::Error (bad command line: exit code 2).
 
 #include <filesystem>
@@ -18,7 +20,10 @@ namespace outburst {
 
 class OutputFolder {
  public:
-  OutputFolder(std::filesystem::path directory, const std::string& program, bool overwrite);
+  // What to do with an earlier run's files: refuse them, remove them, or keep
+  // them for a restart.
+  enum class Earlier { refuse, overwrite, restart };
+  OutputFolder(std::filesystem::path directory, const std::string& program, Earlier earlier);
   ~OutputFolder();
   OutputFolder(const OutputFolder&) = delete;
   OutputFolder& operator=(const OutputFolder&) = delete;

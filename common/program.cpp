@@ -26,6 +26,11 @@ std::filesystem::path RunOptions::output_directory() const {
 
 bool RunOptions::show_progress() const { return !quiet && stderr_is_terminal(); }
 
+OutputFolder::Earlier RunOptions::earlier_files() const {
+  return restart ? OutputFolder::Earlier::restart
+                 : overwrite ? OutputFolder::Earlier::overwrite : OutputFolder::Earlier::refuse;
+}
+
 output::RunInfo run_info(const std::string& program, const scene::Document& doc,
                          const std::string& units) {
   return {program,
@@ -61,6 +66,24 @@ SceneHeader read_scene_header(const scene::Table& root) {
     limits::refuse_count(*o, "interval", h.end_time / h.output_interval, limits::max_snapshots, "snapshots",
                          fmt::format("end_time {:.3g} s / interval {:.3g} s, a file each; lengthen the interval",
                                      h.end_time, h.output_interval));
+  }
+  h.checkpoint_interval = h.output_interval;
+  if (o) {
+    // Read even when absent, so that --explain lists it with its default.
+    const std::string every_snapshot = fmt::format("{:.17g} s", h.output_interval);
+    h.checkpoint_interval = o->quantity({"checkpoint_interval",
+                                         "simulated time between checkpoints (the run's whole state in "
+                                         "checkpoint.h5), from which --restart continues a stopped run; a "
+                                         "settling stage counts its own time (default: the output interval)",
+                                         every_snapshot, scene::Range::positive()},
+                                        units::time);
+    // Each checkpoint rewrites one file, the run's whole state: not a count
+    // of files, but of full writes.
+    limits::refuse_count(*o, "checkpoint_interval", h.end_time / h.checkpoint_interval, limits::max_snapshots,
+                         "checkpoints",
+                         fmt::format("end_time {:.3g} s / checkpoint_interval {:.3g} s, the whole state each; "
+                                     "lengthen the interval",
+                                     h.end_time, h.checkpoint_interval));
   }
   return h;
 }
@@ -116,8 +139,13 @@ int run_program(const std::string& program, const std::string& description, int 
                  "Override a scene key: dotted.key=<TOML value>, e.g. "
                  "--set seepage.time_step='\"30 min\"'");
   app.add_flag("--check", options.check_only, "Validate the scene and stop");
-  app.add_flag("--overwrite", options.overwrite,
-               "Replace the files of an earlier run in the output folder (otherwise such a folder is refused)");
+  auto* overwrite = app.add_flag("--overwrite", options.overwrite,
+                                 "Replace the files of an earlier run in the output folder (otherwise such a folder "
+                                 "is refused)");
+  app.add_flag("--restart", options.restart,
+               "Continue the run in the output folder from its last checkpoint: give the scene, -o and --set of "
+               "the stopped run (and the same -j for a bit-identical result)")
+      ->excludes(overwrite);
   app.add_flag("--explain", options.explain,
                "Print every key the scene uses with its value, default and meaning");
   app.add_flag("-q,--quiet", options.quiet, "No progress line");
@@ -125,6 +153,16 @@ int run_program(const std::string& program, const std::string& description, int 
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
   app.add_option("-j,--threads", options.threads, "OpenMP threads (default: all cores)")->check(thread_count());
   app.set_version_flag("--version", std::string(version));
+  app.footer(fmt::format(
+      "Exit codes: 0 done; 1 the run failed; 2 bad scene or command line; 3 stopped by SIGINT or SIGTERM; 4 scene "
+      "refused as unworkable.\n\n"
+      "Restart: a run writes its whole state to DIR/checkpoint.h5 every [output] checkpoint_interval of simulated "
+      "time (default: with each snapshot) and when SIGINT or SIGTERM stops it. A run stopped so, killed or crashed "
+      "continues from there with its own command line plus --restart, e.g.\n"
+      "  {} SCENE -o DIR --set key=value --restart\n"
+      "and ends as it would have without the stop, bit for bit. It refuses (exit code 2) a folder without a "
+      "checkpoint, another scene text, mesh or --set, and another build.",
+      program));
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,8 +1,17 @@
 #pragma once
 // The command line shared by every program of the project:
 //
-//   <program> SCENE [--output DIR] [--set key=value]... [--check] [--explain]
-//             [--quiet] [--log-level LEVEL] [--threads N]
+//   <program> SCENE [--output DIR] [--overwrite | --restart] [--set key=value]...
+//             [--check] [--explain] [--quiet] [--log-level LEVEL] [--threads N]
+//
+// Checkpoints (common/checkpoint.hpp): every program writes its complete state
+// to DIR/checkpoint.h5 every [output] checkpoint_interval of simulated time
+// (default: at every snapshot; a settling stage by its own clock) and when a
+// signal stops it. --restart continues the run of DIR from that checkpoint,
+// with the same scene, overrides and build (otherwise exit code 2): the
+// histories and indexes are cut back to the checkpoint's time and go on from
+// there, and the run ends as it would have without the stop, bit for bit at
+// the same thread count.
 //
 // and the one place that turns exceptions into exit codes: 2 for a bad scene or
 // command line (with the file, line and key), 4 for a valid scene refused
@@ -17,7 +26,9 @@
 #include <string>
 #include <vector>
 
+#include "common/checkpoint.hpp"
 #include "common/field_output.hpp"
+#include "common/output_folder.hpp"
 #include "common/scene.hpp"
 
 namespace outburst {
@@ -28,6 +39,7 @@ struct RunOptions {
   std::vector<std::string> overrides;
   bool check_only = false;   // read and validate the scene, run nothing
   bool overwrite = false;    // replace an earlier run's files in the output folder
+  bool restart = false;      // continue the output folder's run from its checkpoint
   bool explain = false;      // print every key the scene uses, with defaults
   bool quiet = false;        // no progress line
   std::string log_level = "info";
@@ -35,6 +47,8 @@ struct RunOptions {
 
   std::filesystem::path output_directory() const;
   bool show_progress() const;
+  // What the output folder does with an earlier run's files.
+  OutputFolder::Earlier earlier_files() const;
 };
 
 // Parse the command line, set up logging and threads, load the scene, and call
@@ -48,6 +62,7 @@ struct SceneHeader {
   std::vector<std::string> solvers;  // which solvers run: "seepage", "mpm"
   double end_time;                   // [s]
   double output_interval;            // simulated time between snapshots [s]
+  double checkpoint_interval;        // simulated time between checkpoints [s]
   // Stop before end_time once the kinetic energy falls below this fraction of
   // its peak (scenes with the mpm solver): the coal has come to rest.
   std::optional<double> rest_fraction;
@@ -64,12 +79,33 @@ class RestWatch {
     return fraction_ && peak_ > 0 && kinetic < *fraction_ * peak_;
   }
   double peak() const { return peak_; }
+  void save(checkpoint::Out out) const { out.number("peak", peak_); }
+  void load(const checkpoint::In& in) { peak_ = in.number("peak"); }
   // Without the criterion a run needs no kinetic energy summed per step.
   bool active() const { return fraction_.has_value(); }
 
  private:
   std::optional<double> fraction_;
   double peak_ = 0;
+};
+
+// When checkpoints are due: each time the simulated time passes another
+// multiple of the interval.
+class CheckpointClock {
+ public:
+  explicit CheckpointClock(double interval) : interval_(interval), next_(interval) {}
+  // True when `time` [s] has reached the next checkpoint time, which then
+  // moves past it.
+  bool due(double time) {
+    if (time < next_ * (1 - 1e-12)) return false;
+    while (next_ <= time * (1 + 1e-12)) next_ += interval_;
+    return true;
+  }
+  void save(checkpoint::Out out) const { out.number("next", next_); }
+  void load(const checkpoint::In& in) { next_ = in.number("next"); }
+
+ private:
+  double interval_, next_;
 };
 
 // Stops with a clear error when a program is given a scene for other solvers.

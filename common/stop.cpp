@@ -37,9 +37,17 @@ void install_stop_handlers() {
 bool stop_requested() { return requested != 0; }
 
 int report_stop(double time, const std::filesystem::path& index) {
-  spdlog::warn("stopped by {} at t = {:.9g} s: the state there is the last snapshot in {}",
-               requested == SIGINT ? "SIGINT" : "SIGTERM", time,
-               std::filesystem::absolute(index).string());
+  spdlog::warn("stopped by {} at t = {:.9g} s: the state there is the last snapshot in {} and the checkpoint "
+               "--restart continues from",
+               requested == SIGINT ? "SIGINT" : "SIGTERM", time, std::filesystem::absolute(index).string());
+  return exit_stopped;
+}
+
+int report_settling_stop(double time, double duration, const std::filesystem::path& checkpoint) {
+  spdlog::warn("stopped by {} while settling, at {:.9g} s of the {:.9g} s stage (before t = 0: no snapshot yet): "
+               "the state there is the checkpoint {}, which --restart continues from",
+               requested == SIGINT ? "SIGINT" : "SIGTERM", time, duration,
+               std::filesystem::absolute(checkpoint).string());
   return exit_stopped;
 }
 

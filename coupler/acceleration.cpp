@@ -3,6 +3,7 @@
 #include <stdexcept>
 
 #include <Eigen/QR>
+#include <fmt/format.h>
 
 namespace outburst::coupling {
 
@@ -125,6 +126,34 @@ void IqnIls::end_window(bool converged) {
   }
   v_.clear();
   w_.clear();
+}
+
+void IqnIls::save(checkpoint::Out out) const {
+  out.count("windows", static_cast<std::int64_t>(past_v_.size()));
+  for (std::size_t k = 0; k < past_v_.size(); ++k) {
+    const auto window = out.group(fmt::format("window_{}", k));
+    window.count("columns", static_cast<std::int64_t>(past_v_[k].size()));
+    for (std::size_t j = 0; j < past_v_[k].size(); ++j) {
+      window.numbers(fmt::format("v_{}", j), past_v_[k][j]);
+      window.numbers(fmt::format("w_{}", j), past_w_[k][j]);
+    }
+  }
+}
+
+void IqnIls::load(const checkpoint::In& in) {
+  past_v_.clear();
+  past_w_.clear();
+  const auto windows = in.count("windows");
+  for (std::int64_t k = 0; k < windows; ++k) {
+    const auto window = in.group(fmt::format("window_{}", k));
+    auto& v = past_v_.emplace_back();
+    auto& w = past_w_.emplace_back();
+    const auto columns = window.count("columns");
+    for (std::int64_t j = 0; j < columns; ++j) {
+      v.push_back(window.vector(fmt::format("v_{}", j)));
+      w.push_back(window.vector(fmt::format("w_{}", j), static_cast<std::size_t>(v.back().size())));
+    }
+  }
 }
 
 }  // namespace outburst::coupling

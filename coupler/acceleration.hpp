@@ -25,6 +25,8 @@
 
 #include <Eigen/Core>
 
+#include "common/checkpoint.hpp"
+
 namespace outburst::coupling {
 
 // Where each field sits in the stacked vector.
@@ -56,6 +58,11 @@ class Acceleration {
   virtual Eigen::VectorXd next(const Eigen::VectorXd& y, const Eigen::VectorXd& x) = 0;
   // The window ended; converged windows feed reuse.
   virtual void end_window(bool /*converged*/) {}
+  // What it carries from window to window, to and from a checkpoint (taken
+  // between windows). Constant relaxation and Aitken carry nothing: each
+  // window starts them afresh.
+  virtual void save(checkpoint::Out /*out*/) const {}
+  virtual void load(const checkpoint::In& /*in*/) {}
 
  protected:
   // Per-entry weights of the preconditioner, set at a window's first iteration.
@@ -93,6 +100,9 @@ class IqnIls final : public Acceleration {
   void start_window(const std::vector<FieldSlice>& fields) override;
   Eigen::VectorXd next(const Eigen::VectorXd& y, const Eigen::VectorXd& x) override;
   void end_window(bool converged) override;
+  // The columns of the past windows kept for reuse.
+  void save(checkpoint::Out out) const override;
+  void load(const checkpoint::In& in) override;
 
  private:
   AccelerationSettings settings_;

@@ -158,4 +158,79 @@ const WindowRecord& Coupling::advance(double window) {
   return records_.back();
 }
 
+void Coupling::save(checkpoint::Out out) const {
+  out.number("time", time_);
+  out.flag("have_y", have_y_);
+  out.numbers("y", y_);
+  std::string names;
+  std::vector<std::int64_t> extents;
+  for (const auto& s : slices_) {
+    names += s.name + "\n";
+    extents.insert(extents.end(), {static_cast<std::int64_t>(s.offset), static_cast<std::int64_t>(s.size)});
+  }
+  out.text("slice_names", names);
+  out.counts("slice_extents", extents);
+  // The records, a column each; the residuals of all, one after another.
+  const auto records = out.group("records");
+  std::vector<double> start, size, first, second, coupler, residuals;
+  std::vector<std::int64_t> iterations, converged, residual_counts;
+  for (const auto& r : records_) {
+    start.push_back(r.start);
+    size.push_back(r.size);
+    iterations.push_back(r.iterations);
+    converged.push_back(r.converged);
+    residual_counts.push_back(static_cast<std::int64_t>(r.residuals.size()));
+    residuals.insert(residuals.end(), r.residuals.begin(), r.residuals.end());
+    first.push_back(r.first_seconds);
+    second.push_back(r.second_seconds);
+    coupler.push_back(r.coupler_seconds);
+  }
+  records.numbers("start", start);
+  records.numbers("size", size);
+  records.counts("iterations", iterations);
+  records.counts("converged", converged);
+  records.counts("residual_counts", residual_counts);
+  records.numbers("residuals", residuals);
+  records.numbers("first_seconds", first);
+  records.numbers("second_seconds", second);
+  records.numbers("coupler_seconds", coupler);
+  if (acceleration_) acceleration_->save(out.group("acceleration"));
+}
+
+void Coupling::load(const checkpoint::In& in) {
+  time_ = in.number("time");
+  have_y_ = in.flag("have_y");
+  y_ = in.vector("y");
+  const std::string names = in.text("slice_names");
+  const auto extents = in.counts<std::int64_t>("slice_extents");
+  slices_.clear();
+  for (std::size_t start = 0, end, k = 0; (end = names.find('\n', start)) != std::string::npos; start = end + 1, ++k) {
+    if (2 * k + 1 >= extents.size()) in.fail("slice_extents", "fewer extents than slice names");
+    slices_.push_back({names.substr(start, end - start), static_cast<std::size_t>(extents[2 * k]),
+                       static_cast<std::size_t>(extents[2 * k + 1])});
+  }
+  const auto records = in.group("records");
+  const auto start = records.numbers("start");
+  const std::size_t n = start.size();
+  const auto size = records.numbers("size", n);
+  const auto iterations = records.counts<int>("iterations", n);
+  const auto converged = records.counts<int>("converged", n);
+  const auto residual_counts = records.counts<std::size_t>("residual_counts", n);
+  const auto residuals = records.numbers("residuals");
+  const auto first = records.numbers("first_seconds", n);
+  const auto second = records.numbers("second_seconds", n);
+  const auto coupler = records.numbers("coupler_seconds", n);
+  records_.clear();
+  std::size_t at = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    if (at + residual_counts[k] > residuals.size()) records.fail("residuals", "fewer residuals than counted");
+    records_.push_back({start[k], size[k], iterations[k], converged[k] != 0,
+                        {residuals.begin() + static_cast<std::ptrdiff_t>(at),
+                         residuals.begin() + static_cast<std::ptrdiff_t>(at + residual_counts[k])},
+                        first[k], second[k], coupler[k]});
+    at += residual_counts[k];
+  }
+  if (acceleration_) acceleration_->load(in.group("acceleration"));
+}
+
 }  // namespace outburst::coupling

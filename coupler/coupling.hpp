@@ -82,6 +82,12 @@ class Coupling {
   const std::vector<WindowRecord>& records() const { return records_; }
   const SchemeSettings& settings() const { return settings_; }
 
+  // The coupling's own state between windows (time, records, the data second
+  // last sent first and the acceleration's history), to and from a
+  // checkpoint; the participants save theirs.
+  void save(checkpoint::Out out) const;
+  void load(const checkpoint::In& in);
+
  private:
   Eigen::VectorXd read_to_first(WindowRecord& record);
   void write_to_first(const Eigen::VectorXd& y, WindowRecord& record);

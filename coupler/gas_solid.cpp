@@ -103,6 +103,23 @@ void SeepageParticipant::advance(double window) {
   last_size_ = window;
 }
 
+void SeepageParticipant::save_between_windows(checkpoint::Out out) const {
+  out.numbers("occupancy", occupancy_);
+  out.numbers("stress", stress_);
+  out.numbers("damage", damage_);
+  out.numbers("dilatation", dilatation_);
+  out.number("last_size", last_size_);
+}
+
+void SeepageParticipant::load_between_windows(const checkpoint::In& in) {
+  const auto cells = static_cast<std::size_t>(occupancy_.size());
+  occupancy_ = in.vector("occupancy", cells);
+  stress_ = in.vector("stress", 3 * cells);
+  damage_ = in.vector("damage", cells);
+  dilatation_ = in.vector("dilatation", cells);
+  last_size_ = in.number("last_size");
+}
+
 void SeepageParticipant::save() { saved_ = solver_.save_state(); }
 void SeepageParticipant::restore() { solver_.restore_state(saved_); }
 
@@ -233,6 +250,22 @@ void SolidParticipant::advance(double window) {
   }
   felt_change_ = pressure_end_ - pressure_start_;
   pressure_start_ = pressure_end_;
+  averages_.reset();
+}
+
+void SolidParticipant::save_between_windows(checkpoint::Out out) const {
+  out.numbers("pressure_start", pressure_start_);
+  out.numbers("pressure_end", pressure_end_);
+  out.numbers("felt_change", felt_change_);
+  out.counts("cell_hint", cell_hint_);
+}
+
+void SolidParticipant::load_between_windows(const checkpoint::In& in) {
+  const auto nodes = static_cast<std::size_t>(pressure_start_.size());
+  pressure_start_ = in.vector("pressure_start", nodes);
+  pressure_end_ = in.vector("pressure_end", nodes);
+  felt_change_ = in.vector("felt_change", nodes);
+  cell_hint_ = in.counts<int>("cell_hint");
   averages_.reset();
 }
 

@@ -86,6 +86,12 @@ class SeepageParticipant final : public Participant {
   void save() override;
   void restore() override;
 
+  // What it carries from window to window (the solid's last data and the
+  // last window's size; the solver saves its own state), to and from a
+  // checkpoint.
+  void save_between_windows(checkpoint::Out out) const;
+  void load_between_windows(const checkpoint::In& in);
+
   int open_cells() const { return open_cells_; }
   // The seepage solver's report of the last advance (sub-steps, cuts, iterations).
   const seepage::StepReport& last_report() const { return last_report_; }
@@ -127,6 +133,12 @@ class SolidParticipant final : public Participant {
   // nodes between regions (the face, between coal and tunnel) start at a mean,
   // which is not the pressure in the coal before it is exposed.
   void make_initial_stress_effective(const std::vector<double>& cell_pressure);
+  // What it carries from window to window (the pressures at the window's
+  // ends, the change felt, the cells the particles were last found in; the
+  // solver saves its own state), to and from a checkpoint.
+  void save_between_windows(checkpoint::Out out) const;
+  void load_between_windows(const checkpoint::In& in);
+
   // The last advance: its last MPM step and the particles that left the grid.
   const mpm::StepInfo& last_window() const { return last_window_; }
 

@@ -2,6 +2,7 @@
 // solver run as partners of a coupling (coupler/coupling.hpp) window by window.
 #include <chrono>
 #include <fstream>
+#include <optional>
 #include <stdexcept>
 
 #include <spdlog/spdlog.h>
@@ -20,10 +21,14 @@ using namespace outburst;
 namespace {
 
 // Per window: what the coupling cost and how it converged, flushed line by line.
+// A restarted run (resume) writes no header and appends once load() has cut
+// the log back to the checkpoint.
 class WindowLog {
  public:
-  WindowLog(const std::filesystem::path& file, const std::vector<coupling::Convergence>& fields)
-      : out_(file), fields_(fields.size()) {
+  WindowLog(const std::filesystem::path& file, const std::vector<coupling::Convergence>& fields, bool resume)
+      : path_(file), fields_(fields.size()) {
+    if (resume) return;
+    out_.open(file);
     out_ << "window,time,size,iterations,converged,seepage_s,solid_s,coupler_s,open_cells,gas_released,"
             "kinetic_energy,particles";
     for (const auto& f : fields) out_ << ",residual_" << f.field;
@@ -41,8 +46,11 @@ class WindowLog {
     out_.flush();
     if (!out_) throw std::runtime_error("cannot write coupling.csv: the disk may be full");
   }
+  void save(checkpoint::Out out) const { checkpoint::save_length(out, "bytes", path_); }
+  void load(const checkpoint::In& in) { checkpoint::cut_back(in, "bytes", path_, out_); }
 
  private:
+  std::filesystem::path path_;
   std::ofstream out_;
   std::size_t fields_;
 };
@@ -61,25 +69,53 @@ int run(const RunOptions& options, scene::Document& doc) {
   doc.reject_unused();
   check_run_length(doc.root(), setup);
   if (!finish_reading(options, doc)) return 0;
-  const OutputFolder folder(options.output_directory(), "outburst", options.overwrite);
+  const OutputFolder folder(options.output_directory(), "outburst", options.earlier_files());
+  const auto& directory = folder.path();
+  const auto info = run_info("outburst", doc, "SI: m, s, kg, Pa; 2D plane strain, per metre of depth; MPM stresses "
+                                              "are effective (total = effective - alpha p I)");
+  std::optional<checkpoint::Reader> restart;
+  if (options.restart) restart.emplace(directory, info);
+  // A checkpoint of the settling stage continues it; the run then starts as
+  // a fresh one would, outputs and all.
+  const bool resume_run = restart && restart->stage() == checkpoint::Stage::run;
   const SceneHeader header = setup.header;
   const auto tracers = setup.solid.tracers;
-  coupling::CoupledModel model(std::move(setup));
-  if (const auto left = model.settled())
+  const mpm::Settling settling = setup.solid.settling;
+  coupling::CoupledModel model(std::move(setup), /*settle_later=*/true);
+  if (settling.duration > 0 && !resume_run) {
+    CheckpointClock checkpoints(header.checkpoint_interval);
+    if (restart) {
+      const auto root = restart->root();
+      model.load(root.group("model"));
+      checkpoints.load(root.group("settling").group("checkpoints"));
+      spdlog::info("restarted from {} while settling, at {:.9g} s of the {:.9g} s stage", restart->path().string(),
+                   model.solid().time(), settling.duration);
+    }
+    const auto pause = [&] {
+      const bool stop = stop_requested();
+      if (checkpoints.due(model.solid().time()) || stop) {
+        checkpoint::Writer file(directory, info, checkpoint::Stage::settling);
+        auto root = file.root();
+        model.save(root.group("model"));
+        checkpoints.save(root.group("settling").group("checkpoints"));
+        file.commit();
+      }
+      return stop;
+    };
+    if (!model.settle(pause))
+      return report_settling_stop(model.solid().time(), settling.duration, directory / checkpoint::file_name);
     spdlog::info("settled for {:.3g} s: kinetic energy down to {:.2e} of its peak; supports removed",
-                 model.setup().solid.settling.duration, *left);
+                 settling.duration, *model.settled());
+  }
   auto& seepage_solver = model.seepage();
   auto& solid = model.solid();
   const auto& cs = model.setup().coupling;
   spdlog::info("{}: {} seepage cells, {} particles, window {:.3g} s", header.title, model.mapping().mesh().num_cells(),
                solid.particles().size(), cs.window);
 
-  const auto& directory = folder.path();
-  const auto info = run_info("outburst", doc, "SI: m, s, kg, Pa; 2D plane strain, per metre of depth; MPM stresses "
-                                              "are effective (total = effective - alpha p I)");
-  seepage::Output seepage_out(directory, info, seepage_solver);
-  mpm::Output solid_out(directory, info, tracers);
-  WindowLog log(directory / "coupling.csv", cs.scheme.to_first);
+  seepage::Output seepage_out(directory, info, seepage_solver, resume_run);
+  mpm::Output solid_out(directory, info, tracers, resume_run);
+  WindowLog log(directory / "coupling.csv", cs.scheme.to_first, resume_run);
   seepage_out.series().list_with_others();
   solid_out.series().list_with_others();
   const auto snapshot = [&] {
@@ -87,14 +123,45 @@ int run(const RunOptions& options, scene::Document& doc) {
     solid_out.snapshot(solid);
     output::publish({&seepage_out.series(), &solid_out.series()});
   };
-  snapshot();
 
   const auto wall_start = std::chrono::steady_clock::now();
-  Progress progress("outburst", 0.0, header.end_time, options.show_progress());
   double next_output = header.output_interval;
   long iterations = 0;
   const auto& coupler = model.coupling();
   RestWatch rest(header.rest_fraction);
+  CheckpointClock checkpoints(header.checkpoint_interval);
+  const auto save_checkpoint = [&] {
+    checkpoint::Writer file(directory, info, checkpoint::Stage::run);
+    auto root = file.root();
+    model.save(root.group("model"));
+    seepage_out.save(root.group("seepage_output"));
+    solid_out.save(root.group("mpm_output"));
+    log.save(root.group("coupling_log"));
+    const auto run = root.group("run");
+    run.number("next_output", next_output);
+    run.count("iterations", iterations);
+    rest.save(run.group("rest"));
+    checkpoints.save(run.group("checkpoints"));
+    file.commit();
+  };
+  if (resume_run) {
+    const auto root = restart->root();
+    model.load(root.group("model"));
+    seepage_out.load(root.group("seepage_output"));
+    solid_out.load(root.group("mpm_output"));
+    log.load(root.group("coupling_log"));
+    const auto run = root.group("run");
+    next_output = run.number("next_output");
+    iterations = run.count("iterations");
+    rest.load(run.group("rest"));
+    checkpoints.load(run.group("checkpoints"));
+    spdlog::info("restarted from {} at t = {:.9g} s, window {}", restart->path().string(), coupler.time(),
+                 coupler.records().size());
+  } else {
+    snapshot();
+  }
+
+  Progress progress("outburst", coupler.time(), header.end_time, options.show_progress());
   bool at_rest = false;
   while (coupler.time() < header.end_time * (1 - 1e-12)) {
     const double target = std::min(next_output, header.end_time);
@@ -110,11 +177,15 @@ int run(const RunOptions& options, scene::Document& doc) {
     const bool output_due = coupler.time() >= target * (1 - 1e-12);
     at_rest = rest.at_rest(kinetic);
     const bool stop = stop_requested();  // read once: a signal may come in between
-    if (output_due || at_rest || stop) {
+    if (output_due || at_rest) {
       snapshot();
       if (output_due) next_output += header.output_interval;
     }
+    if (checkpoints.due(coupler.time()) || stop) save_checkpoint();
     if (stop) {
+      // After the checkpoint: a restart drops this extra snapshot, and its
+      // folder ends as the uninterrupted run's would.
+      if (!output_due && !at_rest) snapshot();
       progress.finish();
       return report_stop(coupler.time(), directory);
     }

@@ -182,7 +182,7 @@ CoupledSetup read_coupled_setup(scene::Table root) {
   return s;
 }
 
-CoupledModel::CoupledModel(CoupledSetup setup) : setup_(std::move(setup)) {
+CoupledModel::CoupledModel(CoupledSetup setup, bool settle_later) : setup_(std::move(setup)) {
   auto& seep = setup_.seepage;
   auto& solid = setup_.solid;
   const CouplingSetup& cs = setup_.coupling;
@@ -209,9 +209,30 @@ CoupledModel::CoupledModel(CoupledSetup setup) : setup_(std::move(setup)) {
       cell_pressure.push_back(seep.model.materials[static_cast<std::size_t>(region)].initial_pressure);
     solid_side_->make_initial_stress_effective(cell_pressure);
   }
-  // The gas pressure starts uniform in each region: no gas force while settling.
-  if (solid.settling.duration > 0) settled_ = solid_->settle(solid.settling, solid.fixed_time_step);
   coupling_ = std::make_unique<Coupling>(*seepage_side_, *solid_side_, cs.scheme);
+  if (solid.settling.duration > 0 && !settle_later) settle({});
+}
+
+// The gas pressure starts uniform in each region: no gas force while settling.
+bool CoupledModel::settle(const std::function<bool()>& pause) {
+  settled_ = solid_->settle(setup_.solid.settling, setup_.solid.fixed_time_step, pause);
+  return settled_.has_value();
+}
+
+void CoupledModel::save(checkpoint::Out out) const {
+  seepage_->save(out.group("seepage"));
+  solid_->save(out.group("mpm"));
+  seepage_side_->save_between_windows(out.group("seepage_side"));
+  solid_side_->save_between_windows(out.group("solid_side"));
+  coupling_->save(out.group("coupling"));
+}
+
+void CoupledModel::load(const checkpoint::In& in) {
+  seepage_->load(in.group("seepage"));
+  solid_->load(in.group("mpm"));
+  seepage_side_->load_between_windows(in.group("seepage_side"));
+  solid_side_->load_between_windows(in.group("solid_side"));
+  coupling_->load(in.group("coupling"));
 }
 
 const WindowRecord& CoupledModel::advance(double limit) {

@@ -4,6 +4,7 @@
 // coupling needs (total initial stresses made effective, then the solid's
 // settling stage). The `outburst` program and the tests build it alike.
 
+#include <functional>
 #include <memory>
 #include <optional>
 
@@ -40,7 +41,13 @@ std::vector<stability::Regime> poroelastic_regimes(const CoupledSetup& setup);
 
 class CoupledModel {
  public:
-  explicit CoupledModel(CoupledSetup setup);
+  // The solid's settling stage runs here, unless `settle_later`: then
+  // settle() runs it, or load() of a checkpoint of the run makes it needless.
+  explicit CoupledModel(CoupledSetup setup, bool settle_later = false);
+  // Runs the settling stage, or carries on with it after load() of a
+  // checkpoint taken during it; `pause` as for mpm::Solver::settle. False
+  // when paused.
+  bool settle(const std::function<bool()>& pause);
 
   // One coupling window, cut short at `limit`.
   const WindowRecord& advance(double limit);
@@ -52,6 +59,11 @@ class CoupledModel {
   const SeepageParticipant& seepage_side() const { return *seepage_side_; }
   const SolidParticipant& solid_side() const { return *solid_side_; }
   const Coupling& coupling() const { return *coupling_; }
+  // Both solvers, both participants and the coupling, to and from a
+  // checkpoint taken between windows.
+  void save(checkpoint::Out out) const;
+  void load(const checkpoint::In& in);
+
   // Kinetic energy left by the settling stage over its peak (nullopt: no stage).
   std::optional<double> settled() const { return settled_; }
 

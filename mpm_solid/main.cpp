@@ -1,5 +1,6 @@
 // mpm-solid: the MPM solver for coal and rock on its own (dry scenes).
 #include <chrono>
+#include <optional>
 
 #include <spdlog/spdlog.h>
 
@@ -33,24 +34,75 @@ int run(const RunOptions& options, scene::Document& doc) {
                                              "choose",
                                              *setup.fixed_time_step, stable / setup.settings.courant));
   if (!finish_reading(options, doc)) return 0;
-  const OutputFolder folder(options.output_directory(), "mpm-solid", options.overwrite);
+  const OutputFolder folder(options.output_directory(), "mpm-solid", options.earlier_files());
   spdlog::info("{}: {} particles, {} x {} cells of {:g} m, stable step {:.3g} s", header.title,
                solver.particles().size(), setup.grid.cells[0], setup.grid.cells[1], setup.grid.h, stable);
+  const auto info = run_info("mpm-solid", doc, "SI: m, s, kg, Pa; 2D plane strain, per metre of depth");
+  std::optional<checkpoint::Reader> restart;
+  if (options.restart) restart.emplace(folder.path(), info);
+  // A checkpoint of the settling stage continues it; the run then starts as
+  // a fresh one would, outputs and all.
+  const bool resume_run = restart && restart->stage() == checkpoint::Stage::run;
 
   const auto wall_start = std::chrono::steady_clock::now();
-  if (setup.settling.duration > 0) {
-    const double left = solver.settle(setup.settling, setup.fixed_time_step);
+  if (setup.settling.duration > 0 && !resume_run) {
+    CheckpointClock checkpoints(header.checkpoint_interval);
+    if (restart) {
+      const auto root = restart->root();
+      solver.load(root.group("mpm"));
+      checkpoints.load(root.group("settling").group("checkpoints"));
+      spdlog::info("restarted from {} while settling, at {:.9g} s of the {:.9g} s stage", restart->path().string(),
+                   solver.time(), setup.settling.duration);
+    }
+    const auto pause = [&] {
+      const bool stop = stop_requested();
+      if (checkpoints.due(solver.time()) || stop) {
+        checkpoint::Writer file(folder.path(), info, checkpoint::Stage::settling);
+        auto root = file.root();
+        solver.save(root.group("mpm"));
+        checkpoints.save(root.group("settling").group("checkpoints"));
+        file.commit();
+      }
+      return stop;
+    };
+    const auto left = solver.settle(setup.settling, setup.fixed_time_step, pause);
+    if (!left)
+      return report_settling_stop(solver.time(), setup.settling.duration, folder.path() / checkpoint::file_name);
     spdlog::info("settled for {:.3g} s: kinetic energy down to {:.2e} of its peak; supports removed",
-                 setup.settling.duration, left);
+                 setup.settling.duration, *left);
   }
-  mpm::Output out(folder.path(), run_info("mpm-solid", doc, "SI: m, s, kg, Pa; 2D plane strain, "
-                                                                         "per metre of depth"),
-                  setup.tracers);
-  out.snapshot(solver);
+  mpm::Output out(folder.path(), info, setup.tracers, resume_run);
   double last_snapshot_time = 0;
-  Progress progress("mpm", 0.0, header.end_time, options.show_progress());
   double next_output = header.output_interval;
   RestWatch rest(header.rest_fraction);
+  CheckpointClock checkpoints(header.checkpoint_interval);
+  const auto save_checkpoint = [&] {
+    checkpoint::Writer file(folder.path(), info, checkpoint::Stage::run);
+    auto root = file.root();
+    solver.save(root.group("mpm"));
+    out.save(root.group("output"));
+    const auto run = root.group("run");
+    run.number("next_output", next_output);
+    run.number("last_snapshot_time", last_snapshot_time);
+    rest.save(run.group("rest"));
+    checkpoints.save(run.group("checkpoints"));
+    file.commit();
+  };
+  if (resume_run) {
+    const auto root = restart->root();
+    solver.load(root.group("mpm"));
+    out.load(root.group("output"));
+    const auto run = root.group("run");
+    next_output = run.number("next_output");
+    last_snapshot_time = run.number("last_snapshot_time");
+    rest.load(run.group("rest"));
+    checkpoints.load(run.group("checkpoints"));
+    spdlog::info("restarted from {} at t = {:.9g} s, step {}", restart->path().string(), solver.time(),
+                 solver.steps());
+  } else {
+    out.snapshot(solver);
+  }
+  Progress progress("mpm", solver.time(), header.end_time, options.show_progress());
   bool at_rest = false;
   while (solver.time() < header.end_time * (1 - 1e-12)) {
     const double target = std::min(next_output, header.end_time);
@@ -70,12 +122,16 @@ int run(const RunOptions& options, scene::Document& doc) {
     const bool output_due = solver.time() >= target * (1 - 1e-12);
     at_rest = rest.active() && rest.at_rest(solver.kinetic_energy());
     const bool stop = stop_requested();  // read once: a signal may come in between
-    if (output_due || at_rest || stop) {
+    if (output_due || at_rest) {
       out.snapshot(solver);
       last_snapshot_time = solver.time();
       if (output_due) next_output += header.output_interval;
     }
+    if (checkpoints.due(solver.time()) || stop) save_checkpoint();
     if (stop) {
+      // After the checkpoint: a restart drops this extra snapshot, and its
+      // folder ends as the uninterrupted run's would.
+      if (!output_due && !at_rest) out.snapshot(solver);
       progress.finish();
       return report_stop(solver.time(), out.series().index_path());
     }

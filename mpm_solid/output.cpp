@@ -14,19 +14,39 @@ std::pair<double, double> principal_extremes(const Mat<2>& s, double s_zz) {
   return {std::max(centre + radius, s_zz), std::min(centre - radius, s_zz)};
 }
 
-Output::Output(const std::filesystem::path& directory, const output::RunInfo& info, std::vector<int> tracers)
-    : series_(directory, "particles", info), tracers_(std::move(tracers)) {
+Output::Output(const std::filesystem::path& directory, const output::RunInfo& info, std::vector<int> tracers,
+               bool resume)
+    : directory_(directory), series_(directory, "particles", info), tracers_(std::move(tracers)) {
+  series_.add_point_grid("particles");
+  if (resume) return;
   if (!tracers_.empty()) {
-    tracer_file_.open(directory / "tracers.csv", std::ios::trunc);
+    tracer_file_.open(tracer_path(), std::ios::trunc);
     tracer_file_ << "time_s,tracer,particle_id,x_m,y_m,vx_m_per_s,vy_m_per_s,speed_m_per_s,ux_m,uy_m,"
                     "sigma_max_Pa,sigma_min_Pa,plastic_strain,damage\n";
   }
-  series_.add_point_grid("particles");
-  history_.open(directory / "mpm_history.csv", std::ios::trunc);
+  history_.open(history_path(), std::ios::trunc);
   history_ << "step,time_s,dt_s,particles,removed_total,kinetic_J_per_m,strain_J_per_m,gravity_J_per_m,"
               "plastic_J_per_m,damage_J_per_m,damping_J_per_m,walls_J_per_m,transfer_J_per_m,left_grid_J_per_m,"
               "external_work_J_per_m,balance_error_J_per_m\n";
   history_.flush();
+}
+
+void Output::save(checkpoint::Out out) const {
+  series_.save(out.group("series"));
+  checkpoint::save_length(out, "history_bytes", history_path());
+  if (!tracers_.empty()) checkpoint::save_length(out, "tracer_bytes", tracer_path());
+  out.flag("has_initial_total", initial_total_.has_value());
+  out.number("initial_total", initial_total_.value_or(0.0));
+  audit_.save(out.group("audit"));
+}
+
+void Output::load(const checkpoint::In& in) {
+  series_.load(in.group("series"));
+  checkpoint::cut_back(in, "history_bytes", history_path(), history_);
+  if (!tracers_.empty()) checkpoint::cut_back(in, "tracer_bytes", tracer_path(), tracer_file_);
+  initial_total_.reset();
+  if (in.flag("has_initial_total")) initial_total_ = in.number("initial_total");
+  audit_.load(in.group("audit"));
 }
 
 void Output::snapshot(const Solver& solver) {

@@ -19,7 +19,10 @@ std::pair<double, double> principal_extremes(const Mat<2>& s, double s_zz);
 class Output {
  public:
   // `tracers`: ids of particles whose state is written every step to tracers.csv.
-  Output(const std::filesystem::path& directory, const output::RunInfo& info, std::vector<int> tracers);
+  // A restarted run (resume) writes no headers and appends once load() has
+  // cut the histories back to the checkpoint.
+  Output(const std::filesystem::path& directory, const output::RunInfo& info, std::vector<int> tracers,
+         bool resume = false);
   void snapshot(const Solver& solver);
   void history(const Solver& solver, const StepInfo& step);
   const output::FieldSeries& series() const { return series_; }
@@ -30,7 +33,14 @@ class Output {
   const EnergyAudit& energy_audit() const { return audit_; }
   void finish() const;
 
+  void save(checkpoint::Out out) const;
+  void load(const checkpoint::In& in);
+
  private:
+  std::filesystem::path history_path() const { return directory_ / "mpm_history.csv"; }
+  std::filesystem::path tracer_path() const { return directory_ / "tracers.csv"; }
+
+  std::filesystem::path directory_;
   output::FieldSeries series_;
   std::ofstream history_;
   std::optional<double> initial_total_;  // energy total when the history starts

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "common/checkpoint.hpp"
 #include "mpm_solid/grid.hpp"
 
 namespace outburst::mpm {
@@ -54,6 +55,63 @@ struct Particles {
   }
 
   std::size_t size() const { return x.size(); }
+
+  // Every field, to and from a checkpoint; optional fields as present.
+  void save(checkpoint::Out out) const {
+    out.matrices("x", x);
+    out.matrices("x0", x0);
+    out.matrices("v", v);
+    out.numbers("mass", mass);
+    out.numbers("volume", volume);
+    out.numbers("volume0", volume0);
+    out.numbers("half_width", half_width);
+    out.matrices("stress", stress);
+    out.numbers("stress_zz", stress_zz);
+    out.matrices("velocity_gradient", velocity_gradient);
+    out.matrices("deformation", deformation);
+    out.matrices("affine", affine);
+    out.counts("material", material);
+    out.counts("id", id);
+    const auto optional = out.group("optional");
+    if (!external_force.empty()) {
+      optional.matrices("external_force", external_force);
+      optional.matrices("surface_force", surface_force);
+    }
+    if (!pore_pressure.empty()) optional.numbers("pore_pressure", pore_pressure);
+    if (!plastic_strain.empty()) optional.numbers("plastic_strain", plastic_strain);
+    if (!damage.empty()) {
+      optional.numbers("damage", damage);
+      optional.matrices("effective_stress", effective_stress);
+      optional.numbers("effective_stress_zz", effective_stress_zz);
+    }
+  }
+  void load(const checkpoint::In& in) {
+    x = in.matrices<Dim, 1>("x");
+    const std::size_t n = x.size();
+    x0 = in.matrices<Dim, 1>("x0", n);
+    v = in.matrices<Dim, 1>("v", n);
+    mass = in.numbers("mass", n);
+    volume = in.numbers("volume", n);
+    volume0 = in.numbers("volume0", n);
+    half_width = in.numbers("half_width", n);
+    stress = in.matrices<Dim, Dim>("stress", n);
+    stress_zz = in.numbers("stress_zz", n);
+    velocity_gradient = in.matrices<Dim, Dim>("velocity_gradient", n);
+    deformation = in.matrices<Dim, Dim>("deformation", n);
+    affine = in.matrices<Dim, Dim>("affine", n);
+    material = in.counts<std::int32_t>("material", n);
+    id = in.counts<std::int32_t>("id", n);
+    const auto optional = in.group("optional");
+    const bool loads = optional.has("external_force");
+    external_force = loads ? optional.matrices<Dim, 1>("external_force", n) : std::vector<Vec<Dim>>{};
+    surface_force = loads ? optional.matrices<Dim, 1>("surface_force", n) : std::vector<Vec<Dim>>{};
+    pore_pressure = optional.has("pore_pressure") ? optional.numbers("pore_pressure", n) : std::vector<double>{};
+    plastic_strain = optional.has("plastic_strain") ? optional.numbers("plastic_strain", n) : std::vector<double>{};
+    const bool damaged = optional.has("damage");
+    damage = damaged ? optional.numbers("damage", n) : std::vector<double>{};
+    effective_stress = damaged ? optional.matrices<Dim, Dim>("effective_stress", n) : std::vector<Mat<Dim>>{};
+    effective_stress_zz = damaged ? optional.numbers("effective_stress_zz", n) : std::vector<double>{};
+  }
 
   void add(const Vec<Dim>& position, const Vec<Dim>& velocity, double particle_mass,
            double particle_volume, double half_width_cells, const Mat<Dim>& initial_stress,

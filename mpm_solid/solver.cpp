@@ -675,25 +675,76 @@ void Solver::shift_initial_stress(const std::vector<double>& per_particle) {
   }
 }
 
-double Solver::settle(const Settling& stage, std::optional<double> fixed_step) {
+std::optional<double> Solver::settle(const Settling& stage, std::optional<double> fixed_step,
+                                     const std::function<bool()>& pause) {
+  if (settled_) throw std::logic_error("settle: the settling stage is over");
   const double scene_damping = settings_.local_damping;
   settings_.local_damping = stage.damping;
-  double largest = 0, kinetic = 0;
   while (time_ < stage.duration * (1 - 1e-12)) {
     step(std::min(fixed_step ? *fixed_step : stable_time_step(), stage.duration - time_));
-    kinetic = kinetic_energy();
-    largest = std::max(largest, kinetic);
+    settling_kinetic_ = kinetic_energy();
+    settling_peak_ = std::max(settling_peak_, settling_kinetic_);
+    if (pause && pause()) {
+      settings_.local_damping = scene_damping;
+      return std::nullopt;
+    }
   }
   settings_.local_damping = scene_damping;
-  std::erase_if(settings_.obstacles, [](const Obstacle& o) { return o.support; });
-  find_obstacle_nodes();
+  remove_supports();
   for (auto& v : particles_.v) v.setZero();
   for (auto& b : particles_.affine) b.setZero();
   time_ = 0;
   steps_ = 0;
   dissipated_ = {};
   std::fill(platen_displacement_.begin(), platen_displacement_.end(), 0.0);
-  return largest > 0 ? kinetic / largest : 0.0;
+  return settling_peak_ > 0 ? settling_kinetic_ / settling_peak_ : 0.0;
+}
+
+void Solver::save(checkpoint::Out out) const {
+  particles_.save(out.group("particles"));
+  out.number("time", time_);
+  out.count("steps", steps_);
+  out.count("removed", static_cast<std::int64_t>(removed_));
+  dissipated_.save(out, "dissipated");
+  out.numbers("platen_displacement", platen_displacement_);
+  out.flag("settled", settled_);
+  out.numbers("settling_kinetic", std::vector<double>{settling_peak_, settling_kinetic_});
+}
+
+void Solver::load(const checkpoint::In& in) {
+  const auto group = in.group("particles");
+  Particles<2> p;
+  p.load(group);
+  for (const auto m : p.material)
+    if (m < 0 || static_cast<std::size_t>(m) >= materials_.size())
+      group.fail("material", fmt::format("material {} of a scene with {}", m, materials_.size()));
+  particles_ = std::move(p);
+  rebuild_material_groups();
+  time_ = in.number("time");
+  steps_ = in.count("steps");
+  removed_ = static_cast<std::size_t>(in.count("removed"));
+  dissipated_ = Energies::load(in, "dissipated");
+  platen_displacement_ = in.numbers("platen_displacement", settings_.platens.size());
+  const auto settling = in.numbers("settling_kinetic", 2);
+  settling_peak_ = settling[0];
+  settling_kinetic_ = settling[1];
+  if (in.flag("settled") && !settled_) remove_supports();
+}
+
+void Solver::remove_supports() {
+  std::erase_if(settings_.obstacles, [](const Obstacle& o) { return o.support; });
+  find_obstacle_nodes();
+  settled_ = true;
+}
+
+void Energies::save(checkpoint::Out out, const std::string& name) const {
+  out.numbers(name, std::vector<double>{kinetic, strain, gravity, plastic, damage, damping, walls, transfer, left,
+                                        external});
+}
+
+Energies Energies::load(const checkpoint::In& in, const std::string& name) {
+  const auto v = in.numbers(name, 10);
+  return {v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8], v[9]};
 }
 
 void Solver::restore_state(const State& s) {
@@ -731,6 +782,22 @@ Energies Solver::energies() const {
   return e;
 }
 
+
+void EnergyAudit::save(checkpoint::Out out) const {
+  out.flag("started", first_.has_value());
+  if (first_) first_->save(out, "first");
+  out.numbers("measures", std::vector<double>{largest_term_, worst_error_, worst_time_, last_error_});
+}
+
+void EnergyAudit::load(const checkpoint::In& in) {
+  first_.reset();
+  if (in.flag("started")) first_ = Energies::load(in, "first");
+  const auto m = in.numbers("measures", 4);
+  largest_term_ = m[0];
+  worst_error_ = m[1];
+  worst_time_ = m[2];
+  last_error_ = m[3];
+}
 
 void EnergyAudit::record(const Energies& e, double time) {
   if (!first_) first_ = e;

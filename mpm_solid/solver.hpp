@@ -14,6 +14,7 @@
 // branch per particle.
 
 #include <array>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -129,6 +130,8 @@ struct Energies {
   double total() const {
     return kinetic + strain + gravity + plastic + damage + damping + walls + transfer + left - external;
   }
+  void save(checkpoint::Out out, const std::string& name) const;
+  static Energies load(const checkpoint::In& in, const std::string& name);
 };
 
 // Whether a run's energy books close: over the states recorded, the largest
@@ -143,6 +146,8 @@ class EnergyAudit {
   double final_share() const { return largest_term_ > 0 ? last_error_ / largest_term_ : 0.0; }
   double largest_term() const { return largest_term_; }
   double worst_time() const { return worst_time_; }
+  void save(checkpoint::Out out) const;
+  void load(const checkpoint::In& in);
 
  private:
   std::optional<Energies> first_;
@@ -216,12 +221,22 @@ class Solver {
   };
   State save_state() const { return {time_, steps_, removed_, particles_, dissipated_, platen_displacement_}; }
   void restore_state(const State& s);
+  // The state to and from a checkpoint (a run continued by --restart), the
+  // settling stage's progress included. A checkpoint of the dynamic stage
+  // removes the supports as settle() did; the stage need not run again.
+  void save(checkpoint::Out out) const;
+  void load(const checkpoint::In& in);
 
   // Runs the quasi-static stage (steps of `fixed_step` or the CFL step), then
   // starts the dynamic one: supports removed, material at rest, clock and
   // energy books at zero, local damping back to the scene's. Returns the
   // kinetic energy left at the end of the stage, relative to its largest.
-  double settle(const Settling& stage, std::optional<double> fixed_step);
+  // `pause`, called after each step of the stage (time() is the stage's
+  // clock then), may stop it by returning true: settle() then returns
+  // nullopt, and called again, after load() of a checkpoint taken then if
+  // need be, carries on where it stopped.
+  std::optional<double> settle(const Settling& stage, std::optional<double> fixed_step,
+                               const std::function<bool()>& pause = {});
 
   // How far each platen has moved along its axis since t = 0 [m].
   const std::vector<double>& platen_displacement() const { return platen_displacement_; }
@@ -251,6 +266,7 @@ class Solver {
   double apply_walls(std::vector<Vec<2>>& velocity) const;
   void apply_platens(std::vector<Vec<2>>& velocity, double impulse, double dt);
   void find_obstacle_nodes();
+  void remove_supports();  // the settling stage is over
   void fold_ghosts(std::vector<double>* mass, std::vector<Vec<2>>& vectors) const;
   void update_stresses(double dt);
   void count(int i, double dt, Census& census) const;
@@ -294,6 +310,9 @@ class Solver {
   long steps_ = 0;
   std::size_t removed_ = 0;
   Energies dissipated_;  // only the accumulated members are used
+  bool settled_ = false;  // a settling stage ran: its supports are gone
+  // Of the settling stage so far: the largest kinetic energy and the last [J/m].
+  double settling_peak_ = 0, settling_kinetic_ = 0;
 };
 
 }  // namespace outburst::mpm

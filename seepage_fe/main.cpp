@@ -1,5 +1,6 @@
 // seepage-fe: the gas seepage solver on its own (verification, drainage studies).
 #include <chrono>
+#include <optional>
 
 #include <spdlog/spdlog.h>
 
@@ -32,17 +33,45 @@ int run(const RunOptions& options, scene::Document& doc) {
                solver.mesh().num_nodes(), solver.mesh().num_cells(), gas ? "gas" : "linear",
                format_duration(header.end_time));
 
-  const OutputFolder folder(options.output_directory(), "seepage-fe", options.overwrite);
-  seepage::Output out(folder.path(), run_info("seepage-fe", doc, gas ? "SI: m, s, Pa; P = p^2 in Pa^2; "
-                                                                  "gas volumes at standard conditions"
-                                                                : "SI: m, s, Pa"),
-                      solver);
-  out.snapshot(solver);
+  const OutputFolder folder(options.output_directory(), "seepage-fe", options.earlier_files());
+  const auto info = run_info("seepage-fe", doc, gas ? "SI: m, s, Pa; P = p^2 in Pa^2; gas volumes at standard conditions"
+                                                    : "SI: m, s, Pa");
+  std::optional<checkpoint::Reader> restart;
+  if (options.restart) restart.emplace(folder.path(), info);
+  seepage::Output out(folder.path(), info, solver, options.restart);
 
-  Progress progress("seepage", 0.0, header.end_time, options.show_progress());
   double dt = setup.steps.first;
   double next_output = header.output_interval;
   long iterations = 0;
+  CheckpointClock checkpoints(header.checkpoint_interval);
+  const auto save_checkpoint = [&] {
+    checkpoint::Writer file(folder.path(), info, checkpoint::Stage::run);
+    auto root = file.root();
+    solver.save(root.group("seepage"));
+    out.save(root.group("output"));
+    const auto run = root.group("run");
+    run.number("dt", dt);
+    run.number("next_output", next_output);
+    run.count("iterations", iterations);
+    checkpoints.save(run.group("checkpoints"));
+    file.commit();
+  };
+  if (restart) {
+    const auto root = restart->root();
+    solver.load(root.group("seepage"));
+    out.load(root.group("output"));
+    const auto run = root.group("run");
+    dt = run.number("dt");
+    next_output = run.number("next_output");
+    iterations = run.count("iterations");
+    checkpoints.load(run.group("checkpoints"));
+    spdlog::info("restarted from {} at t = {:.9g} s, step {}", restart->path().string(), solver.time(),
+                 solver.steps());
+  } else {
+    out.snapshot(solver);
+  }
+
+  Progress progress("seepage", solver.time(), header.end_time, options.show_progress());
   while (solver.time() < header.end_time * (1 - 1e-12)) {
     const double target = std::min(next_output, header.end_time);
     const double h = std::min(dt, target - solver.time());
@@ -53,14 +82,20 @@ int run(const RunOptions& options, scene::Document& doc) {
                     fmt::format("iterations {}", report.nonlinear_iterations));
     const bool output_due = solver.time() >= target * (1 - 1e-12);
     const bool stop = stop_requested();  // read once: a signal may come in between
-    if (output_due || stop) out.snapshot(solver);
-    if (output_due) next_output += header.output_interval;
-    if (stop) {
-      progress.finish();
-      return report_stop(solver.time(), out.series().index_path());
+    if (output_due) {
+      out.snapshot(solver);
+      next_output += header.output_interval;
     }
     // A step shortened to land on an output time does not shrink the next one.
     if (h == dt) dt = std::min(dt * setup.steps.growth, setup.steps.maximum);
+    if (checkpoints.due(solver.time()) || stop) save_checkpoint();
+    if (stop) {
+      // After the checkpoint: a restart drops this extra snapshot, and its
+      // folder ends as the uninterrupted run's would.
+      if (!output_due) out.snapshot(solver);
+      progress.finish();
+      return report_stop(solver.time(), out.series().index_path());
+    }
   }
   progress.finish();
 

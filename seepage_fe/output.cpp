@@ -7,8 +7,8 @@
 namespace outburst::seepage {
 
 Output::Output(const std::filesystem::path& directory, const output::RunInfo& info,
-               const Solver& solver)
-    : series_(directory, "seepage", info) {
+               const Solver& solver, bool resume)
+    : series_(directory, "seepage", info), history_path_(directory / "seepage_history.csv") {
   const Mesh& mesh = solver.mesh();
   std::vector<double> xyz;
   for (const auto& p : mesh.nodes) xyz.insert(xyz.end(), {p.x(), p.y(), 0.0});
@@ -16,11 +16,22 @@ Output::Output(const std::filesystem::path& directory, const output::RunInfo& in
   for (const auto& c : mesh.cells) quads.insert(quads.end(), c.begin(), c.end());
   series_.add_quad_mesh("mesh", xyz, quads);
 
-  history_.open(directory / "seepage_history.csv", std::ios::trunc);
+  if (resume) return;
+  history_.open(history_path_, std::ios::trunc);
   history_ << "step,time_s,dt_s,substeps,cuts,iterations,stored_m3_per_m,inflow_flux_m3_per_m";
   for (const auto& b : solver.balance().pressure_boundaries) history_ << ",inflow_" << b << "_m3_per_m";
   history_ << ",balance_error_relative\n";
   history_.flush();
+}
+
+void Output::save(checkpoint::Out out) const {
+  series_.save(out.group("series"));
+  checkpoint::save_length(out, "history_bytes", history_path_);
+}
+
+void Output::load(const checkpoint::In& in) {
+  series_.load(in.group("series"));
+  checkpoint::cut_back(in, "history_bytes", history_path_, history_);
 }
 
 void Output::snapshot(const Solver& solver) {

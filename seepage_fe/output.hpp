@@ -2,6 +2,8 @@
 // What a seepage run writes: the field time series for ParaView (nodal p and P,
 // cell conductivity, flux and region) and a per-step history CSV with the gas
 // balance, appended and flushed line by line so a crash loses nothing written.
+// A restarted run (resume) writes no header and appends once load() has cut
+// the history back to the checkpoint.
 
 #include <filesystem>
 #include <fstream>
@@ -14,7 +16,8 @@ namespace outburst::seepage {
 
 class Output {
  public:
-  Output(const std::filesystem::path& directory, const output::RunInfo& info, const Solver& solver);
+  Output(const std::filesystem::path& directory, const output::RunInfo& info, const Solver& solver,
+         bool resume = false);
 
   void snapshot(const Solver& solver);
   void history(const Solver& solver, double dt, const StepReport& report);
@@ -22,8 +25,12 @@ class Output {
   const output::FieldSeries& series() const { return series_; }
   output::FieldSeries& series() { return series_; }
 
+  void save(checkpoint::Out out) const;
+  void load(const checkpoint::In& in);
+
  private:
   output::FieldSeries series_;
+  std::filesystem::path history_path_;
   std::ofstream history_;
 };
 

@@ -522,6 +522,78 @@ Solver::State Solver::save_state() const {
           last_inflow_pressure_, last_inflow_flux_, fixed_by_, pressure_bc_slot_, open_pressure_};
 }
 
+// A mesh file may change under an unchanged scene text.
+std::int64_t Solver::mesh_fingerprint() const {
+  checkpoint::Fingerprint f;
+  f.add(mesh_.nodes);
+  f.add(mesh_.cells);
+  f.add(mesh_.cell_region);
+  for (const auto& b : mesh_.boundaries) {
+    f.add(b.name.data(), b.name.size());
+    f.add(b.edges);
+  }
+  return f.value();
+}
+
+void Solver::save(checkpoint::Out out) const {
+  out.count("mesh_fingerprint", mesh_fingerprint());
+  out.number("time", time_);
+  out.count("steps", steps_);
+  out.numbers("u", u_);
+  out.numbers("u_previous", u_previous_);
+  out.number("dt_previous", dt_previous_);
+  out.flag("has_previous", has_previous_);
+  out.numbers("conductivity", conductivity_);
+  const auto b = out.group("balance");
+  b.number("initial_stored", balance_.initial_stored);
+  b.number("stored", balance_.stored);
+  b.number("inflow_through_flux", balance_.inflow_through_flux);
+  std::string names;
+  for (const auto& n : balance_.pressure_boundaries) names += n + "\n";
+  b.text("pressure_boundaries", names);
+  b.numbers("inflow_through_pressure", balance_.inflow_through_pressure);
+  b.numbers("last_inflow_pressure", last_inflow_pressure_);
+  b.number("last_inflow_flux", last_inflow_flux_);
+  out.counts("fixed_by", fixed_by_);
+  out.counts("pressure_bc_slot", pressure_bc_slot_);
+  out.number("open_pressure", open_pressure_);
+}
+
+void Solver::load(const checkpoint::In& in) {
+  if (in.count("mesh_fingerprint") != mesh_fingerprint())
+    in.refuse("written for another seepage mesh (the mesh file changed since); finish the run with that mesh, or "
+              "start afresh");
+  const std::size_t nodes = mesh_.num_nodes();
+  State s;
+  s.time = in.number("time");
+  s.steps = in.count("steps");
+  s.u = in.vector("u", nodes);
+  s.u_previous = in.vector("u_previous", nodes);
+  s.dt_previous = in.number("dt_previous");
+  s.has_previous = in.flag("has_previous");
+  s.conductivity = in.numbers("conductivity", mesh_.num_cells());
+  const auto b = in.group("balance");
+  s.balance.initial_stored = b.number("initial_stored");
+  s.balance.stored = b.number("stored");
+  s.balance.inflow_through_flux = b.number("inflow_through_flux");
+  const std::string names = b.text("pressure_boundaries");
+  for (std::size_t start = 0, end; (end = names.find('\n', start)) != std::string::npos; start = end + 1)
+    s.balance.pressure_boundaries.push_back(names.substr(start, end - start));
+  const std::size_t slots = s.balance.pressure_boundaries.size();
+  s.balance.inflow_through_pressure = b.numbers("inflow_through_pressure", slots);
+  s.last_inflow_pressure = b.numbers("last_inflow_pressure", slots);
+  s.last_inflow_flux = b.number("last_inflow_flux");
+  s.fixed_by = in.counts<int>("fixed_by", nodes);
+  s.pressure_bc_slot = in.counts<int>("pressure_bc_slot");
+  s.open_pressure = in.number("open_pressure");
+  const int conditions = static_cast<int>(model_.boundary_conditions.size());
+  for (const int by : s.fixed_by)
+    if (by < -1 || by > conditions) in.fail("fixed_by", fmt::format("a node fixed by condition {} of {}", by, conditions));
+  for (const int slot : s.pressure_bc_slot)
+    if (slot < -1 || slot >= static_cast<int>(slots)) in.fail("pressure_bc_slot", fmt::format("slot {} of {}", slot, slots));
+  restore_state(s);
+}
+
 void Solver::restore_state(const State& s) {
   time_ = s.time;
   steps_ = s.steps;

@@ -20,6 +20,7 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
+#include "common/checkpoint.hpp"
 #include "seepage_fe/cell_locator.hpp"
 #include "seepage_fe/mesh.hpp"
 #include "seepage_fe/model.hpp"
@@ -120,6 +121,9 @@ class Solver {
   };
   State save_state() const;
   void restore_state(const State& state);
+  // The state to and from a checkpoint (a run continued by --restart).
+  void save(checkpoint::Out out) const;
+  void load(const checkpoint::In& in);
 
   // ---- results
   const Mesh& mesh() const { return mesh_; }
@@ -165,6 +169,7 @@ class Solver {
   std::vector<int> dirichlet_zero_;    // value indices zeroed in the Jacobian
   std::vector<int> dirichlet_diagonal_;
   void find_dirichlet_entries();
+  std::int64_t mesh_fingerprint() const;
   std::vector<int> boundary_fixed_by_;  // fixed_by_ as the scene's conditions alone set it
   double open_pressure_ = 0;
 
