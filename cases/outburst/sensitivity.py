@@ -3,15 +3,18 @@
 paper does not give, and to resolution.
 
 usage: sensitivity.py [--outburst build/coupler/outburst] [--out results/outburst_sensitivity]
-                      [--end-time "1 s"] [--only TEXT]
+                      [--end-time "1 s"] [--only TEXT] [--resume]
 writes OUT/sensitivity.md and OUT/sensitivity.csv; one run per row (one at a
 time: each uses every core), 11 minutes on 2 cores for the parameter rows;
 --only runs the rows whose label holds TEXT (--only transfer: the grid
 transfer rows, PIC share 0, 0.01, 0.05 and APIC at the shipped and the double
-resolution).
+resolution, 40 minutes). Each finished row is kept in its run folder
+(row.json); --resume reads the rows an interrupted study finished with the
+same overrides and end time instead of running them again.
 """
 import argparse
 import csv
+import json
 import os
 import subprocess
 import sys
@@ -93,6 +96,7 @@ def main():
     ap.add_argument("--out", default="results/outburst_sensitivity")
     ap.add_argument("--end-time", default="1 s")
     ap.add_argument("--only", default="", help="run only the rows whose label holds this text")
+    ap.add_argument("--resume", action="store_true", help="keep the rows an earlier run of the study finished")
     args = ap.parse_args()
     os.makedirs(args.out, exist_ok=True)
     rows = []
@@ -101,16 +105,27 @@ def main():
     for k, (label, overrides) in chosen:
         overrides = [mesh if o == "FINE_MESH" else o for o in overrides]
         run_dir = os.path.join(args.out, f"run_{k:02d}")
-        wall, failure = run_one(args.outburst, os.path.join(HERE, "outburst.toml"),
-                                [f'scene.end_time="{args.end_time}"'] + overrides, run_dir, os.cpu_count() or 1)
+        overrides = [f'scene.end_time="{args.end_time}"'] + overrides
+        kept = os.path.join(run_dir, "row.json")
+        if args.resume and os.path.exists(kept):
+            with open(kept) as f:
+                earlier = json.load(f)
+            if earlier["overrides"] == overrides:
+                rows.append(earlier["row"])
+                print(f"{label}: kept from {kept}", flush=True)
+                continue
+        wall, failure = run_one(args.outburst, os.path.join(HERE, "outburst.toml"), overrides, run_dir,
+                                os.cpu_count() or 1)
         if failure:
             # A setting that blows up is a result too: the row says where.
             print(f"sensitivity: {label}: {failure}", flush=True)
-            rows.append({"variant": label, "wall_s": wall, "failure": failure.split("] ")[-1]})
-            continue
-        row = {"variant": label, "wall_s": wall, **headline(run_dir)}
+            row = {"variant": label, "wall_s": wall, "failure": failure.split("] ")[-1]}
+        else:
+            row = {"variant": label, "wall_s": wall, **headline(run_dir)}
+            print(f"{label}: {row}", flush=True)
         rows.append(row)
-        print(f"{label}: {row}", flush=True)
+        with open(kept, "w") as f:
+            json.dump({"overrides": overrides, "row": row}, f)
     fields = []
     for r in rows:
         fields += [k for k in r if k not in fields]
