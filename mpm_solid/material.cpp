@@ -239,7 +239,7 @@ double ElasticDamage::damage(double previous, const Mat<2>& effective, double ef
   const auto strain = [&](double si, double sj, double sk) { return (si - nu * (sj + sk)) / e0; };
   double damage = previous;
   if (s1 >= d.tensile_strength) {
-    const double eps1 = strain(s1, s2, s3), eps_t0 = d.tensile_strength / e0;
+    const double eps1 = strain(s1, s2, s3);
     const double tensile =
         eps1 >= ultimate_strain_ ? 1.0 : 1 - d.residual_ratio * d.tensile_strength / (e0 * eps1);
     damage = std::max(damage, tensile);

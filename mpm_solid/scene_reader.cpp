@@ -76,7 +76,7 @@ void read_platens(const scene::Table& s, Settings& st, const Grid<2>& grid) {
     }
     const int axis =
         t.choice<int>({"direction", "the axis the plate moves along: \"x\" or \"y\""}, {{"x", 0}, {"y", 1}});
-    Platen platen{lov, hiv, axis};
+    Platen platen{lov, hiv, axis, 0, std::nullopt};
     if (t.has("velocity")) {
       if (t.has("force")) t.fail("force", "give the plate a force or a velocity, not both");
       platen.velocity = t.quantity({"velocity", "speed of a displacement-controlled plate along that axis, whatever "

@@ -378,7 +378,7 @@ TEST_CASE("a rigid platen presses two columns side by side to one settlement, lo
   // by O(omega dt) (30 % of the load's work at Courant 0.3, 0.6 % at 0.05).
   s.courant = 0.05;
   s.walls = {Wall{Wall::Type::roller}, Wall{}, Wall{Wall::Type::roller}, Wall{}};
-  s.platens.push_back({Vec<2>(-1, b), Vec<2>(2, 2), 1, -force});
+  s.platens.push_back({Vec<2>(-1, b), Vec<2>(2, 2), 1, -force, std::nullopt});
   auto particles = block(gr, {0, 0}, {1, b}, 1000, 2);
   for (std::size_t i = 0; i < particles.size(); ++i) particles.material[i] = particles.x[i].x() < 0.5 ? 0 : 1;
   std::vector<std::unique_ptr<Material>> materials;
