@@ -119,8 +119,10 @@ void Output::history(const Solver& solver, const StepInfo& step) {
 void Output::finish() const {
   const double open = audit_.open_share();
   if (open > 0.01)
-    spdlog::warn("the energy budget is open by {:.2g} % of its largest term ({:.3g} J/m) at t = {:.4g} s: the "
-                 "time step may be too close to the stable one, or the run went unstable (mpm_history.csv)",
+    spdlog::warn("the energy budget is open by {:.2g} % of its largest term ({:.3g} J/m) at t = {:.4g} s: "
+                 "impacts on walls and obstacles are not booked (a few per cent where coal strikes them, "
+                 "mpm_solid/README.md); more means a time step too close to the stable one, or a run gone "
+                 "unstable (mpm_history.csv)",
                  100 * open, audit_.largest_term(), audit_.worst_time());
   else
     spdlog::info("energy budget closed to {:.2g} % of its largest term ({:.3g} J/m)", 100 * open,
