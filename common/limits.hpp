@@ -15,6 +15,9 @@ namespace outburst::limits {
 // MPM steps of the outburst case (6480 particles) would take about 36 hours
 // on this project's 2-core machine.
 inline constexpr double max_steps = 1e8;
+// Most particle-steps an MPM run may take: the same 36 hours or so (the step
+// bound alone lets a run of few steps on millions of particles through).
+inline constexpr double max_particle_steps = 1e8 * 6480;
 // Most snapshots a run may write (one file each).
 inline constexpr double max_snapshots = 1e5;
 

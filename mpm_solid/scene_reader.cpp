@@ -461,12 +461,22 @@ std::string overhang(const Grid<2>& grid, const Vec<2>& lo, const Vec<2>& hi) {
   return text;
 }
 
+// Refuses a run whose particles times steps are beyond any real run's.
+void check_particle_steps(const scene::Table& mpm, const Setup& setup, double steps) {
+  const double particles = static_cast<double>(setup.particles.size());
+  limits::refuse_count(mpm, "bodies", particles * steps, limits::max_particle_steps, "particle-steps",
+                       fmt::format("{:.3g} particles over {:.3g} steps; coarsen grid.cell_size or lower "
+                                   "particles_per_cell, or shorten the run",
+                                   particles, steps));
+}
+
 void check_run_length(const scene::Table& mpm, const Setup& setup, double end_time) {
   const double span = setup.settling.duration + end_time;
   if (setup.fixed_time_step) {
     limits::refuse_count(mpm, "time_step", span / *setup.fixed_time_step, limits::max_steps, "MPM steps",
                          fmt::format("settling and end_time, {:.3g} s, in steps of {:.3g} s; lengthen time_step", span,
                                      *setup.fixed_time_step));
+    check_particle_steps(mpm, setup, span / *setup.fixed_time_step);
     return;
   }
   // The stable step at the start, as the solver computes it.
@@ -485,6 +495,7 @@ void check_run_length(const scene::Table& mpm, const Setup& setup, double end_ti
                   "speed of the P wave of material \"{}\" (youngs_modulus, density) and its particles; change those "
                   "or shorten the run",
                   span, setup.settings.courant, setup.grid.h, fastest, setup.materials[material]->name()));
+  check_particle_steps(mpm, setup, span / step);
 }
 
 }  // namespace outburst::mpm
