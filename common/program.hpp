@@ -30,6 +30,7 @@
 #include "common/field_output.hpp"
 #include "common/output_folder.hpp"
 #include "common/scene.hpp"
+#include "common/stop.hpp"
 
 namespace outburst {
 
@@ -106,6 +107,43 @@ class CheckpointClock {
 
  private:
   double interval_, next_;
+};
+
+// The checkpoints of a settling stage (before t = 0), for the programs that
+// settle: `state` (a solver or a coupled model, with save and load) is written
+// under `group` with the stage's own clock whenever one is due and when a
+// signal asks the run to stop.
+template <class State>
+class SettlingCheckpoints {
+ public:
+  SettlingCheckpoints(std::filesystem::path folder, const output::RunInfo& info, double interval, State& state,
+                      std::string group)
+      : folder_(std::move(folder)), info_(info), clock_(interval), state_(state), group_(std::move(group)) {}
+  // Continues a stage a settling checkpoint stopped.
+  void resume(const checkpoint::Reader& restart) {
+    const auto root = restart.root();
+    state_.load(root.group(group_));
+    clock_.load(root.group("settling").group("checkpoints"));
+  }
+  // The stage's pause at `time` [s]: true when a signal asks it to stop.
+  bool pause(double time) {
+    const bool stop = stop_requested();
+    if (clock_.due(time) || stop) {
+      checkpoint::Writer file(folder_, info_, checkpoint::Stage::settling);
+      auto root = file.root();
+      state_.save(root.group(group_));
+      clock_.save(root.group("settling").group("checkpoints"));
+      file.commit();
+    }
+    return stop;
+  }
+
+ private:
+  std::filesystem::path folder_;
+  const output::RunInfo& info_;
+  CheckpointClock clock_;
+  State& state_;
+  std::string group_;
 };
 
 // Stops with a clear error when a program is given a scene for other solvers.

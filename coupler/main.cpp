@@ -83,26 +83,13 @@ int run(const RunOptions& options, scene::Document& doc) {
   const mpm::Settling settling = setup.solid.settling;
   coupling::CoupledModel model(std::move(setup), /*settle_later=*/true);
   if (settling.duration > 0 && !resume_run) {
-    CheckpointClock checkpoints(header.checkpoint_interval);
+    SettlingCheckpoints checkpoints(directory, info, header.checkpoint_interval, model, "model");
     if (restart) {
-      const auto root = restart->root();
-      model.load(root.group("model"));
-      checkpoints.load(root.group("settling").group("checkpoints"));
+      checkpoints.resume(*restart);
       spdlog::info("restarted from {} while settling, at {:.9g} s of the {:.9g} s stage", restart->path().string(),
                    model.solid().time(), settling.duration);
     }
-    const auto pause = [&] {
-      const bool stop = stop_requested();
-      if (checkpoints.due(model.solid().time()) || stop) {
-        checkpoint::Writer file(directory, info, checkpoint::Stage::settling);
-        auto root = file.root();
-        model.save(root.group("model"));
-        checkpoints.save(root.group("settling").group("checkpoints"));
-        file.commit();
-      }
-      return stop;
-    };
-    if (!model.settle(pause))
+    if (!model.settle([&] { return checkpoints.pause(model.solid().time()); }))
       return report_settling_stop(model.solid().time(), settling.duration, directory / checkpoint::file_name);
     spdlog::info("settled for {:.3g} s: kinetic energy down to {:.2e} of its peak; supports removed",
                  settling.duration, *model.settled());

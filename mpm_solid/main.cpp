@@ -46,26 +46,14 @@ int run(const RunOptions& options, scene::Document& doc) {
 
   const auto wall_start = std::chrono::steady_clock::now();
   if (setup.settling.duration > 0 && !resume_run) {
-    CheckpointClock checkpoints(header.checkpoint_interval);
+    SettlingCheckpoints checkpoints(folder.path(), info, header.checkpoint_interval, solver, "mpm");
     if (restart) {
-      const auto root = restart->root();
-      solver.load(root.group("mpm"));
-      checkpoints.load(root.group("settling").group("checkpoints"));
+      checkpoints.resume(*restart);
       spdlog::info("restarted from {} while settling, at {:.9g} s of the {:.9g} s stage", restart->path().string(),
                    solver.time(), setup.settling.duration);
     }
-    const auto pause = [&] {
-      const bool stop = stop_requested();
-      if (checkpoints.due(solver.time()) || stop) {
-        checkpoint::Writer file(folder.path(), info, checkpoint::Stage::settling);
-        auto root = file.root();
-        solver.save(root.group("mpm"));
-        checkpoints.save(root.group("settling").group("checkpoints"));
-        file.commit();
-      }
-      return stop;
-    };
-    const auto left = solver.settle(setup.settling, setup.fixed_time_step, pause);
+    const auto left =
+        solver.settle(setup.settling, setup.fixed_time_step, [&] { return checkpoints.pause(solver.time()); });
     if (!left)
       return report_settling_stop(solver.time(), setup.settling.duration, folder.path() / checkpoint::file_name);
     spdlog::info("settled for {:.3g} s: kinetic energy down to {:.2e} of its peak; supports removed",
