@@ -390,6 +390,13 @@ void Solver::grid_update(double dt) {
         mass_[i] > empty_node_mass_ ? Vec<2>(shrink * (velocity_[i] + dt * force_[i] / mass_[i])) : Vec<2>::Zero();
   apply_platens(velocity_new_, shrink * dt, dt);  // before the walls: the ghost nodes mirror the plate's motion
   dissipated_.walls += apply_walls(velocity_new_);
+  // What pure FLIP particles gain from this update is sum_i m_i v_i . dv_i
+  // here plus sum_p m_p |dv_p|^2 / 2 in gather_motion (Solver::energies).
+  double work = 0;
+#pragma omp parallel for schedule(static) reduction(+ : work)
+  for (std::size_t i = 0; i < n; ++i)
+    if (counted_[i]) work += mass_[i] * velocity_[i].dot(velocity_new_[i] - velocity_[i]);
+  dissipated_.grid_work += work;
   if (c > 0) {
     // The damping force -c m v_new works along the way the nodes carry the
     // particles, v_new dt (after the walls: what a wall stops does not move),
@@ -483,9 +490,9 @@ void Solver::gather_motion(double dt) {
   const int n = static_cast<int>(p.size());
   const double flip = settings_.flip_fraction;
   Census census;
-  double lost = 0, work = 0;
+  double lost = 0, work = 0, gained = 0;
   const bool loads = !lean_build && !p.external_force.empty();
-#pragma omp parallel reduction(merge : census) reduction(+ : lost, work)
+#pragma omp parallel reduction(merge : census) reduction(+ : lost, work, gained)
   {
     Stencil2<Shape> s;
 #pragma omp for schedule(static)
@@ -494,19 +501,27 @@ void Solver::gather_motion(double dt) {
       Vec<2> v_pic = Vec<2>::Zero(), dv = Vec<2>::Zero();
       Mat<2> b = Mat<2>::Zero();
       Vec<2> d = Vec<2>::Zero();  // diagonal of D = sum w (x_i - x_p)(x_i - x_p)^T
+      double spread = 0;          // sum w |dv_i|^2
       for (int k = 0; k < s.count; ++k) {
         const auto node = s.node[k];
+        const Vec<2> change = velocity_new_[node] - velocity_[node];
         v_pic += s.weight[k] * velocity_new_[node];
-        dv += s.weight[k] * (velocity_new_[node] - velocity_[node]);
+        dv += s.weight[k] * change;
+        spread += s.weight[k] * change.squaredNorm();
         if constexpr (Apic) {
           b += s.weight[k] * velocity_new_[node] * s.offset[k].transpose();
           d += s.weight[k] * s.offset[k].cwiseProduct(s.offset[k]);
         }
       }
-      // Pure FLIP hands each particle the grid's change and keeps what the
-      // grid cannot hold (sub-cell velocity differences); the PIC share, and
-      // APIC, replace that with the grid's field: the energy they take.
+      // Pure FLIP hands each particle the grid's change, interpolated: its
+      // kinetic energy gains m (v . dv + |dv|^2 / 2), short of the grid's
+      // share m (v . dv + sum w |dv_i|^2 / 2) by the increment's spread over
+      // the stencil. It keeps what the grid cannot hold (sub-cell velocity
+      // differences); the PIC share, and APIC, replace that with the grid's
+      // field. Both are what the transfer takes.
       const Vec<2> v_flip = p.v[i] + dv;
+      gained += 0.5 * p.mass[i] * spread;
+      lost += 0.5 * p.mass[i] * (spread - dv.squaredNorm());
       if constexpr (!Move) displacement_[i] = dt * v_pic;
       if constexpr (Apic) {
         // D is diagonal for tensor-product shapes that reproduce linear fields;
@@ -532,6 +547,7 @@ void Solver::gather_motion(double dt) {
   if constexpr (Move) census_ = census;
   dissipated_.transfer += lost;
   dissipated_.external += work;
+  dissipated_.grid_work += gained;
 }
 
 // Every transfer of a step uses the particles' positions at its start; they move
@@ -625,8 +641,9 @@ void Solver::remove_escaped(const Census& census, StepInfo& info) {
   for (int i = 0; i < n; ++i)
     if (!keep[i]) {
       leaving[p.material[i]].push_back(i);
-      dissipated_.left +=
-          0.5 * p.mass[i] * p.v[i].squaredNorm() - p.mass[i] * settings_.gravity.dot(p.x[i] - grid_.lower);
+      const double kinetic = 0.5 * p.mass[i] * p.v[i].squaredNorm();
+      dissipated_.left += kinetic - p.mass[i] * settings_.gravity.dot(p.x[i] - grid_.lower);
+      dissipated_.left_kinetic += kinetic;
     }
   for (std::size_t m = 0; m < materials_.size(); ++m)
     if (!leaving[m].empty()) dissipated_.left += materials_[m]->strain_energy(p, leaving[m]);
@@ -638,6 +655,7 @@ void Solver::remove_escaped(const Census& census, StepInfo& info) {
 
 StepInfo Solver::step(double dt) {
   StepInfo info{dt};
+  if (steps_ == 0) dissipated_.stored_start = stored_energy();  // the books open
   (this->*kernel_)(dt);
   dissipated_.external += census_.external_work;
   remove_escaped(census_, info);
@@ -738,13 +756,13 @@ void Solver::remove_supports() {
 }
 
 void Energies::save(checkpoint::Out out, const std::string& name) const {
-  out.numbers(name, std::vector<double>{kinetic, strain, gravity, plastic, damage, damping, walls, transfer, left,
-                                        external});
+  out.numbers(name, std::vector<double>{kinetic, strain, gravity, plastic, damage, damping, walls, transfer,
+                                        integration, left, external, grid_work, left_kinetic, stored_start});
 }
 
 Energies Energies::load(const checkpoint::In& in, const std::string& name) {
-  const auto v = in.numbers(name, 10);
-  return {v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8], v[9]};
+  const auto v = in.numbers(name, 14);
+  return {v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8], v[9], v[10], v[11], v[12], v[13]};
 }
 
 void Solver::restore_state(const State& s) {
@@ -767,36 +785,51 @@ double Solver::kinetic_energy() const {
   return kinetic;
 }
 
-Energies Solver::energies() const {
-  Energies e = dissipated_;
+double Solver::gravitational_energy() const {
   const auto& p = particles_;
   const int n = static_cast<int>(p.size());
   const Vec<2> g = settings_.gravity;
   double gravity = 0;
 #pragma omp parallel for schedule(static) reduction(+ : gravity)
   for (int i = 0; i < n; ++i) gravity -= p.mass[i] * g.dot(p.x[i] - grid_.lower);
-  e.strain = 0;
-  for (std::size_t m = 0; m < materials_.size(); ++m) e.strain += materials_[m]->strain_energy(p, members_[m]);
-  e.kinetic = kinetic_energy();
-  e.gravity = gravity;
-  return e;
+  return gravity;
 }
 
+double Solver::strain_energy() const {
+  double strain = 0;
+  for (std::size_t m = 0; m < materials_.size(); ++m) strain += materials_[m]->strain_energy(particles_, members_[m]);
+  return strain;
+}
+
+Energies Solver::energies() const {
+  Energies e = dissipated_;
+  e.strain = strain_energy();
+  e.kinetic = kinetic_energy();
+  e.gravity = gravitational_energy();
+  // Had the step been exact, the grid's work would equal what the stored,
+  // dissipated and external energies lost; the difference is the step's.
+  if (steps_ > 0)
+    e.integration = -(e.grid_work + e.strain + e.gravity - e.stored_start + e.plastic + e.damage + e.damping +
+                      e.walls + e.left - e.left_kinetic - e.external);
+  return e;
+}
 
 void EnergyAudit::save(checkpoint::Out out) const {
   out.flag("started", first_.has_value());
   if (first_) first_->save(out, "first");
-  out.numbers("measures", std::vector<double>{largest_term_, worst_error_, worst_time_, last_error_});
+  out.numbers("measures",
+              std::vector<double>{largest_term_, worst_error_, worst_time_, last_error_, worst_integration_});
 }
 
 void EnergyAudit::load(const checkpoint::In& in) {
   first_.reset();
   if (in.flag("started")) first_ = Energies::load(in, "first");
-  const auto m = in.numbers("measures", 4);
+  const auto m = in.numbers("measures", 5);
   largest_term_ = m[0];
   worst_error_ = m[1];
   worst_time_ = m[2];
   last_error_ = m[3];
+  worst_integration_ = m[4];
 }
 
 void EnergyAudit::record(const Energies& e, double time) {
@@ -805,6 +838,7 @@ void EnergyAudit::record(const Energies& e, double time) {
   for (double term : {e.kinetic - f.kinetic, e.strain - f.strain, e.gravity - f.gravity, e.plastic, e.damage,
                       e.damping, e.walls, e.transfer, e.left, e.external})
     largest_term_ = std::max(largest_term_, std::abs(term));
+  worst_integration_ = std::max(worst_integration_, std::abs(e.integration - f.integration));
   last_error_ = std::abs(e.total() - f.total());
   if (const double error = last_error_; error > worst_error_) {
     worst_error_ = error;

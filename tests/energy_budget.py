@@ -1,15 +1,17 @@
 #!/usr/bin/python3
-"""Check a run's MPM energy books (mpm_history.csv): every value finite, and the
-balance error never above a share of the largest energy term.
+"""Check a run's MPM energy books (mpm_history.csv): every value finite, the
+balance error and the time step's own error each never above a share of the
+largest energy term.
 
-usage: energy_budget.py DIR [--most-open 0.01]
+usage: energy_budget.py DIR [--most-open 0.01] [--most-step 0.1]
 
 The largest term is the largest change any term of the account shows over the
 run (kinetic, strain and gravitational energy from their first values; the
 dissipated, transferred and external ones from zero), as mpm::EnergyAudit
 measures it. The balance error (total energy now minus at the start) above
-most_open of it at any output means the method lost or created energy the
-books do not hold: a blow-up, or a time step too close to the stable one.
+most_open of it at any output means energy the books do not hold; the time
+step's own error (integration) above most_step, a step too close to the
+stable one or a blow-up.
 """
 import argparse
 import csv
@@ -17,6 +19,8 @@ import math
 import os
 import sys
 
+# The terms whose changes set the scale; the time step's own error is judged
+# against them, not one of them.
 TERMS = ["kinetic", "strain", "gravity", "plastic", "damage", "damping", "walls", "transfer", "left_grid",
          "external_work"]
 
@@ -25,6 +29,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("directory")
     ap.add_argument("--most-open", type=float, default=0.01)
+    ap.add_argument("--most-step", type=float, default=0.1)
     args = ap.parse_args()
     path = os.path.join(args.directory, "mpm_history.csv")
     with open(path) as f:
@@ -40,12 +45,17 @@ def main():
     largest = max(abs(r[f"{t}_J_per_m"] - (first[f"{t}_J_per_m"] if t in stored else 0)) for r in rows for t in TERMS)
     worst = max(rows, key=lambda r: abs(r["balance_error_J_per_m"]))
     share = abs(worst["balance_error_J_per_m"]) / max(largest, 1e-300)
+    step = max(abs(r["integration_J_per_m"] - first["integration_J_per_m"]) for r in rows) / max(largest, 1e-300)
     last = rows[-1]
     print(f"{path}: {len(rows)} outputs to t = {last['time_s']:g} s; largest term {largest:.4g} J/m; balance error at "
           f"most {worst['balance_error_J_per_m']:+.4g} J/m ({share:.2%} of it, t = {worst['time_s']:g} s); "
-          f"transfer {last['transfer_J_per_m']:.4g} J/m, walls {last['walls_J_per_m']:.4g} J/m")
+          f"time step's own error at most {step:.2%}; at the end transfer {last['transfer_J_per_m']:.4g} J/m, "
+          f"time step {last['integration_J_per_m']:.4g} J/m, walls {last['walls_J_per_m']:.4g} J/m")
     if share > args.most_open:
         sys.exit(f"energy books open by {share:.2%} of the largest term (at most {args.most_open:.2%})")
+    if step > args.most_step:
+        sys.exit(f"the time step's own energy error reached {step:.2%} of the largest term (at most "
+                 f"{args.most_step:.2%})")
 
 
 if __name__ == "__main__":

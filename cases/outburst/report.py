@@ -346,18 +346,20 @@ def write_report(run, args, gradients, path):
         "",
         "## Energy budget (J per m of depth, at the end)",
         "",
-        "| gas work | kinetic | strain | plastic | damage | roof, floor (friction) | grid transfer (PIC share) "
-        "| left the grid | balance error |",
-        "|---|---|---|---|---|---|---|---|---|",
+        "| gas work | kinetic | strain | plastic | damage | roof, floor (friction) | grid transfer "
+        "| time step | left the grid | balance error |",
+        "|---|---|---|---|---|---|---|---|---|---|",
         f"| {e['external_work_J_per_m']:.4g} | {e['kinetic_J_per_m']:.4g} | {e['strain_J_per_m']:.4g} | "
         f"{e['plastic_J_per_m']:.4g} | {e['damage_J_per_m']:.4g} | {e['walls_J_per_m']:.4g} | "
-        f"{e['transfer_J_per_m']:.4g} | {e['left_grid_J_per_m']:.4g} | "
-        f"{e['balance_error_J_per_m']:.4g} ({e['balance_error_J_per_m'] / e['external_work_J_per_m']:+.1%} of "
+        f"{e['transfer_J_per_m']:.4g} | {e['integration_J_per_m']:.4g} | {e['left_grid_J_per_m']:.4g} | "
+        f"{e['balance_error_J_per_m']:.4g} ({e['balance_error_J_per_m'] / e['external_work_J_per_m']:+.2%} of "
         "the gas work) |",
         "",
-        "The grid transfer is what the PIC share of the FLIP/PIC blend (or APIC) takes from coal whose "
-        "velocity differs within a cell, separating fragments above all; the balance error is what the "
-        "explicit steps themselves lose (mpm_solid/solver.hpp, Energies).",
+        "The grid transfer is what the grid-to-particle transfer takes from the grid's update: the PIC share "
+        "of the FLIP/PIC blend (or APIC) takes the velocity differences of coal within a cell, separating "
+        "fragments above all, and the update's spread over each particle's nodes is lost in its "
+        "interpolation. The time step is the explicit step's own energy error (negative: energy it gave); "
+        "both fall with the step. The balance error is what neither holds (mpm_solid/README.md, Energies).",
         "",
         "Figures: fig3_pressure.png, fig4_pressure_profile.png, fig5_damage.png, "
         "fig6_min_principal_stress.png, fig7_velocity.png, fig8_tracer_velocity.png, "

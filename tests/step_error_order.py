@@ -1,0 +1,46 @@
+#!/usr/bin/python3
+"""Check that the MPM time step's own energy error (integration_J_per_m in
+mpm_history.csv) falls at the order expected when the step is halved.
+
+usage: step_error_order.py COARSE_DIR FINE_DIR [--order 1] [--slack 0.2]
+
+Both runs cover the same time with the fine run's step half the coarse one's.
+The measure is the largest |integration| over each run; the order observed is
+log2 of their ratio and must lie within slack of the order expected.
+"""
+import argparse
+import csv
+import math
+import os
+import sys
+
+
+def largest_step_error(directory):
+    with open(os.path.join(directory, "mpm_history.csv")) as f:
+        rows = list(csv.DictReader(f))
+    if not rows:
+        sys.exit(f"{directory}: no rows")
+    return max(abs(float(r["integration_J_per_m"])) for r in rows), float(rows[-1]["time_s"])
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("coarse")
+    ap.add_argument("fine")
+    ap.add_argument("--order", type=float, default=1.0)
+    ap.add_argument("--slack", type=float, default=0.2)
+    args = ap.parse_args()
+    (coarse, t_coarse), (fine, t_fine) = largest_step_error(args.coarse), largest_step_error(args.fine)
+    if not math.isclose(t_coarse, t_fine, rel_tol=1e-6):
+        sys.exit(f"the runs end at different times: {t_coarse:g} s and {t_fine:g} s")
+    if fine <= 0:
+        sys.exit(f"{args.fine}: no time step error at all: the books cannot be measuring it")
+    order = math.log2(coarse / fine)
+    print(f"largest time step error {coarse:.4g} J/m, with half the step {fine:.4g} J/m: order {order:.2f} "
+          f"(expected {args.order:g} +- {args.slack:g})")
+    if abs(order - args.order) > args.slack:
+        sys.exit(f"observed order {order:.2f} is not {args.order:g} +- {args.slack:g}")
+
+
+if __name__ == "__main__":
+    main()
