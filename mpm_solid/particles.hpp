@@ -3,6 +3,9 @@
 // vector, so the kernels stream through memory and no particle owns heap data.
 
 #include <cstdint>
+#include <string_view>
+#include <tuple>
+#include <type_traits>
 #include <vector>
 
 #include "common/checkpoint.hpp"
@@ -40,77 +43,86 @@ struct Particles {
   std::vector<Mat<Dim>> effective_stress;   // undamaged stress sigma~ (damage materials)
   std::vector<double> effective_stress_zz;
 
-  void need_loads() {
-    external_force.resize(size(), Vec<Dim>::Zero());
-    surface_force.resize(size(), Vec<Dim>::Zero());
+  // The field table: every field above once, with its checkpoint name and,
+  // for an optional one, the effect that creates it and the field it starts
+  // as when created or grown (zero if none). add, keep, resize and the
+  // checkpoint run over it; a field missing here fails to compile (below).
+  template <class T>
+  struct Field {
+    const char* name;
+    std::vector<T> Particles::*values;
+    const char* effect = nullptr;              // null: every scene carries it
+    std::vector<T> Particles::*starts_as = nullptr;
+    bool optional() const { return effect != nullptr; }
+  };
+  static constexpr auto fields() {
+    using P = Particles;
+    return std::make_tuple(
+        Field<Vec<Dim>>{"x", &P::x}, Field<Vec<Dim>>{"x0", &P::x0}, Field<Vec<Dim>>{"v", &P::v},
+        Field<double>{"mass", &P::mass}, Field<double>{"volume", &P::volume},
+        Field<double>{"volume0", &P::volume0}, Field<double>{"half_width", &P::half_width},
+        Field<Mat<Dim>>{"stress", &P::stress}, Field<double>{"stress_zz", &P::stress_zz},
+        Field<Mat<Dim>>{"velocity_gradient", &P::velocity_gradient},
+        Field<Mat<Dim>>{"deformation", &P::deformation}, Field<Mat<Dim>>{"affine", &P::affine},
+        Field<std::int32_t>{"material", &P::material}, Field<std::int32_t>{"id", &P::id},
+        Field<Vec<Dim>>{"external_force", &P::external_force, "loads"},
+        Field<Vec<Dim>>{"surface_force", &P::surface_force, "loads"},
+        Field<double>{"pore_pressure", &P::pore_pressure, "pore pressure"},
+        Field<double>{"plastic_strain", &P::plastic_strain, "plasticity"},
+        Field<double>{"damage", &P::damage, "damage"},
+        Field<Mat<Dim>>{"effective_stress", &P::effective_stress, "damage", &P::stress},
+        Field<double>{"effective_stress_zz", &P::effective_stress_zz, "damage", &P::stress_zz});
   }
-  void need_pore_pressure() { pore_pressure.resize(size(), 0.0); }
-  void need_plastic_strain() { plastic_strain.resize(size(), 0.0); }
-  // Damage starts at zero, the undamaged stress at the stress.
-  void need_damage() {
-    if (damage.size() == size()) return;
-    damage.assign(size(), 0.0);
-    effective_stress = stress;
-    effective_stress_zz = stress_zz;
+  template <class F>
+  void for_each_field(F&& f) {
+    std::apply([&](const auto&... field) { (f(field, this->*field.values), ...); }, fields());
   }
+  template <class F>
+  void for_each_field(F&& f) const {
+    std::apply([&](const auto&... field) { (f(field, this->*field.values), ...); }, fields());
+  }
+
+  // Creates the optional fields of an effect, at their initial values, if
+  // they are not there yet.
+  void need(const char* effect) {
+    for_each_field([&](const auto& field, auto& values) {
+      if (!field.optional() || std::string_view(field.effect) != effect || values.size() == size()) return;
+      if (field.starts_as)
+        values = this->*field.starts_as;
+      else
+        values.assign(size(), {});
+      if constexpr (requires { values[0].setZero(); })
+        if (!field.starts_as) for (auto& v : values) v.setZero();
+    });
+  }
+  void need_loads() { need("loads"); }
+  void need_pore_pressure() { need("pore pressure"); }
+  void need_plastic_strain() { need("plasticity"); }
+  void need_damage() { need("damage"); }
 
   std::size_t size() const { return x.size(); }
 
   // Every field, to and from a checkpoint; optional fields as present.
   void save(checkpoint::Out out) const {
-    out.matrices("x", x);
-    out.matrices("x0", x0);
-    out.matrices("v", v);
-    out.numbers("mass", mass);
-    out.numbers("volume", volume);
-    out.numbers("volume0", volume0);
-    out.numbers("half_width", half_width);
-    out.matrices("stress", stress);
-    out.numbers("stress_zz", stress_zz);
-    out.matrices("velocity_gradient", velocity_gradient);
-    out.matrices("deformation", deformation);
-    out.matrices("affine", affine);
-    out.counts("material", material);
-    out.counts("id", id);
     const auto optional = out.group("optional");
-    if (!external_force.empty()) {
-      optional.matrices("external_force", external_force);
-      optional.matrices("surface_force", surface_force);
-    }
-    if (!pore_pressure.empty()) optional.numbers("pore_pressure", pore_pressure);
-    if (!plastic_strain.empty()) optional.numbers("plastic_strain", plastic_strain);
-    if (!damage.empty()) {
-      optional.numbers("damage", damage);
-      optional.matrices("effective_stress", effective_stress);
-      optional.numbers("effective_stress_zz", effective_stress_zz);
-    }
+    for_each_field([&](const auto& field, const auto& values) {
+      if (!field.optional())
+        write(out, field.name, values);
+      else if (!values.empty())
+        write(optional, field.name, values);
+    });
   }
   void load(const checkpoint::In& in) {
-    x = in.matrices<Dim, 1>("x");
-    const std::size_t n = x.size();
-    x0 = in.matrices<Dim, 1>("x0", n);
-    v = in.matrices<Dim, 1>("v", n);
-    mass = in.numbers("mass", n);
-    volume = in.numbers("volume", n);
-    volume0 = in.numbers("volume0", n);
-    half_width = in.numbers("half_width", n);
-    stress = in.matrices<Dim, Dim>("stress", n);
-    stress_zz = in.numbers("stress_zz", n);
-    velocity_gradient = in.matrices<Dim, Dim>("velocity_gradient", n);
-    deformation = in.matrices<Dim, Dim>("deformation", n);
-    affine = in.matrices<Dim, Dim>("affine", n);
-    material = in.counts<std::int32_t>("material", n);
-    id = in.counts<std::int32_t>("id", n);
     const auto optional = in.group("optional");
-    const bool loads = optional.has("external_force");
-    external_force = loads ? optional.matrices<Dim, 1>("external_force", n) : std::vector<Vec<Dim>>{};
-    surface_force = loads ? optional.matrices<Dim, 1>("surface_force", n) : std::vector<Vec<Dim>>{};
-    pore_pressure = optional.has("pore_pressure") ? optional.numbers("pore_pressure", n) : std::vector<double>{};
-    plastic_strain = optional.has("plastic_strain") ? optional.numbers("plastic_strain", n) : std::vector<double>{};
-    const bool damaged = optional.has("damage");
-    damage = damaged ? optional.numbers("damage", n) : std::vector<double>{};
-    effective_stress = damaged ? optional.matrices<Dim, Dim>("effective_stress", n) : std::vector<Mat<Dim>>{};
-    effective_stress_zz = damaged ? optional.numbers("effective_stress_zz", n) : std::vector<double>{};
+    const std::size_t n = in.matrices<Dim, 1>("x").size();
+    for_each_field([&](const auto& field, auto& values) {
+      if (!field.optional())
+        read(in, field.name, n, values);
+      else if (optional.has(field.name))
+        read(optional, field.name, n, values);
+      else
+        values.clear();
+    });
   }
 
   void add(const Vec<Dim>& position, const Vec<Dim>& velocity, double particle_mass,
@@ -131,81 +143,54 @@ struct Particles {
     material.push_back(material_index);
     id.push_back(static_cast<std::int32_t>(id.size()));
     // Optional fields present already grow with the particles.
-    if (!external_force.empty()) need_loads();
-    if (!pore_pressure.empty()) need_pore_pressure();
-    if (!plastic_strain.empty()) need_plastic_strain();
-    if (!damage.empty()) {
-      damage.push_back(0.0);
-      effective_stress.push_back(initial_stress);
-      effective_stress_zz.push_back(initial_stress_zz);
-    }
+    for_each_field([&](const auto& field, auto& values) {
+      if (!field.optional() || values.empty()) return;
+      if (field.starts_as)
+        values.push_back((this->*field.starts_as).back());
+      else if constexpr (requires { values[0].setZero(); })
+        values.push_back(std::decay_t<decltype(values[0])>::Zero());
+      else
+        values.push_back({});
+    });
   }
 
   // Keep the particles whose flag is set, in order.
   void keep(const std::vector<char>& flag) {
-    std::size_t to = 0;
-    for (std::size_t from = 0; from < size(); ++from) {
-      if (!flag[from]) continue;
-      if (to != from) {
-        x[to] = x[from];
-        x0[to] = x0[from];
-        v[to] = v[from];
-        mass[to] = mass[from];
-        volume[to] = volume[from];
-        volume0[to] = volume0[from];
-        half_width[to] = half_width[from];
-        stress[to] = stress[from];
-        stress_zz[to] = stress_zz[from];
-        velocity_gradient[to] = velocity_gradient[from];
-        deformation[to] = deformation[from];
-        affine[to] = affine[from];
-        if (!external_force.empty()) {
-          external_force[to] = external_force[from];
-          surface_force[to] = surface_force[from];
-        }
-        if (!pore_pressure.empty()) pore_pressure[to] = pore_pressure[from];
-        if (!plastic_strain.empty()) plastic_strain[to] = plastic_strain[from];
-        if (!damage.empty()) {
-          damage[to] = damage[from];
-          effective_stress[to] = effective_stress[from];
-          effective_stress_zz[to] = effective_stress_zz[from];
-        }
-        material[to] = material[from];
-        id[to] = id[from];
-      }
-      ++to;
-    }
-    resize(to);
+    const std::size_t n = size();
+    for_each_field([&](const auto&, auto& values) {
+      if (values.empty()) return;
+      std::size_t to = 0;
+      for (std::size_t from = 0; from < n; ++from)
+        if (flag[from]) values[to++] = values[from];
+      values.resize(to);
+    });
   }
 
  private:
-  void resize(std::size_t n) {
-    x.resize(n);
-    x0.resize(n);
-    v.resize(n);
-    mass.resize(n);
-    volume.resize(n);
-    volume0.resize(n);
-    half_width.resize(n);
-    stress.resize(n);
-    stress_zz.resize(n);
-    velocity_gradient.resize(n);
-    deformation.resize(n);
-    affine.resize(n);
-    if (!external_force.empty()) {
-      external_force.resize(n);
-      surface_force.resize(n);
-    }
-    if (!pore_pressure.empty()) pore_pressure.resize(n);
-    if (!plastic_strain.empty()) plastic_strain.resize(n);
-    if (!damage.empty()) {
-      damage.resize(n);
-      effective_stress.resize(n);
-      effective_stress_zz.resize(n);
-    }
-    material.resize(n);
-    id.resize(n);
+  template <class T>
+  static void write(checkpoint::Out out, const char* name, const std::vector<T>& values) {
+    if constexpr (std::is_same_v<T, double>)
+      out.numbers(name, values);
+    else if constexpr (std::is_integral_v<T>)
+      out.counts(name, values);
+    else
+      out.matrices(name, values);
+  }
+  template <class T>
+  static void read(const checkpoint::In& in, const char* name, std::size_t n, std::vector<T>& values) {
+    if constexpr (std::is_same_v<T, double>)
+      values = in.numbers(name, n);
+    else if constexpr (std::is_integral_v<T>)
+      values = in.counts<T>(name, n);
+    else
+      values = in.matrices<T::RowsAtCompileTime, T::ColsAtCompileTime>(name, n);
   }
 };
+
+// Every member is a field of the table: a vector added to Particles but not to
+// fields() would be left out of keep (misaligning it after removals) and of
+// checkpoints.
+static_assert(sizeof(Particles<2>) ==
+              std::tuple_size_v<decltype(Particles<2>::fields())> * sizeof(std::vector<double>));
 
 }  // namespace outburst::mpm
