@@ -128,9 +128,9 @@ void Output::history(const Solver& solver, const StepInfo& step) {
 void Output::finish() const {
   const double open = audit_.open_share(), step = audit_.integration_share();
   if (open > 0.01)
-    spdlog::warn("the energy budget is open by {:.2g} % of its largest term ({:.3g} J/m) at t = {:.4g} s: walls or "
-                 "platens took that much from the mapped velocities, or APIC's affine momentum did not come back "
-                 "(mpm_solid/README.md, Energies; mpm_history.csv)",
+    spdlog::warn("the energy budget is open by {:.2g} % of its largest term ({:.3g} J/m) at t = {:.4g} s: a "
+                 "velocity changed where no book sees it, which is a defect of the solver; please report it with "
+                 "the scene (mpm_solid/README.md, Energies; mpm_history.csv)",
                  100 * open, audit_.largest_term(), audit_.worst_time());
   else
     spdlog::info("energy budget closed to {:.2g} % of its largest term ({:.3g} J/m); the time step's own error at "

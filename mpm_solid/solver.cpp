@@ -390,13 +390,20 @@ void Solver::grid_update(double dt) {
         mass_[i] > empty_node_mass_ ? Vec<2>(shrink * (velocity_[i] + dt * force_[i] / mass_[i])) : Vec<2>::Zero();
   apply_platens(velocity_new_, shrink * dt, dt);  // before the walls: the ghost nodes mirror the plate's motion
   dissipated_.walls += apply_walls(velocity_new_);
-  // What pure FLIP particles gain from this update is sum_i m_i v_i . dv_i
-  // here plus sum_p m_p |dv_p|^2 / 2 in gather_motion (Solver::energies).
-  double work = 0;
-#pragma omp parallel for schedule(static) reduction(+ : work)
+  // The grid's work on pure FLIP particles is sum_i p_i . dv_i here, with
+  // the momenta p_i they mapped, plus sum_p m_p |dv_p|^2 / 2 in gather_motion
+  // (Solver::energies). Walls and platens changed p_i to m_i v_i before the
+  // update: that change, worked by the update, is theirs.
+  double work = 0, projected = 0;
+#pragma omp parallel for schedule(static) reduction(+ : work, projected)
   for (std::size_t i = 0; i < n; ++i)
-    if (counted_[i]) work += mass_[i] * velocity_[i].dot(velocity_new_[i] - velocity_[i]);
-  dissipated_.grid_work += work;
+    if (counted_[i]) {
+      const Vec<2> change = velocity_new_[i] - velocity_[i];
+      work += mass_[i] * velocity_[i].dot(change);
+      projected += (momentum_[i] - mass_[i] * velocity_[i]).dot(change);
+    }
+  dissipated_.grid_work += work + projected;
+  dissipated_.walls -= projected;
   if (c > 0) {
     // The damping force -c m v_new works along the way the nodes carry the
     // particles, v_new dt (after the walls: what a wall stops does not move),
@@ -502,6 +509,7 @@ void Solver::gather_motion(double dt) {
       Mat<2> b = Mat<2>::Zero();
       Vec<2> d = Vec<2>::Zero();  // diagonal of D = sum w (x_i - x_p)(x_i - x_p)^T
       double spread = 0;          // sum w |dv_i|^2
+      double affine = 0;          // sum w (C (x_i - x_p)) . dv_i
       for (int k = 0; k < s.count; ++k) {
         const auto node = s.node[k];
         const Vec<2> change = velocity_new_[node] - velocity_[node];
@@ -511,17 +519,21 @@ void Solver::gather_motion(double dt) {
         if constexpr (Apic) {
           b += s.weight[k] * velocity_new_[node] * s.offset[k].transpose();
           d += s.weight[k] * s.offset[k].cwiseProduct(s.offset[k]);
+          // The affine share of the momentum this particle mapped, which
+          // its own velocity does not carry, worked by the update.
+          affine += s.weight[k] * (p.affine[i] * s.offset[k]).dot(change);
         }
       }
       // Pure FLIP hands each particle the grid's change, interpolated: its
       // kinetic energy gains m (v . dv + |dv|^2 / 2), short of the grid's
-      // share m (v . dv + sum w |dv_i|^2 / 2) by the increment's spread over
-      // the stencil. It keeps what the grid cannot hold (sub-cell velocity
-      // differences); the PIC share, and APIC, replace that with the grid's
-      // field. Both are what the transfer takes.
+      // share m ((v + affine) . dv + sum w |dv_i|^2 / 2) by the increment's
+      // spread over the stencil (and under APIC the affine term). It keeps
+      // what the grid cannot hold (sub-cell velocity differences); the PIC
+      // share, and APIC, replace that with the grid's field. All of it is
+      // what the transfer takes.
       const Vec<2> v_flip = p.v[i] + dv;
       gained += 0.5 * p.mass[i] * spread;
-      lost += 0.5 * p.mass[i] * (spread - dv.squaredNorm());
+      lost += 0.5 * p.mass[i] * (spread - dv.squaredNorm()) + p.mass[i] * affine;
       if constexpr (!Move) displacement_[i] = dt * v_pic;
       if constexpr (Apic) {
         // D is diagonal for tensor-product shapes that reproduce linear fields;

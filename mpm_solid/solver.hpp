@@ -121,11 +121,10 @@ class SimulationError : public std::runtime_error {
 // `integration`, what the explicit step itself took (negative: gave): the
 // work of the grid's update along the grid's velocities against the change of
 // the stored, dissipated and external energies it should equal; it falls
-// with the time step. `walls` is the work of wall friction, `left` what
-// particles carried off the grid. What the balance error keeps is what walls
-// and platens take from the mapped velocities before the update (nothing at
-// a fixed or roller wall) and, under APIC, the affine share of the mapped
-// momentum.
+// with the time step. `walls` is the work of wall friction and what walls and
+// platens take from the mapped momenta; `left` what particles carried off the
+// grid. The balance error is then round-off, unless a velocity changes where
+// no book sees it.
 struct Energies {
   double kinetic = 0, strain = 0, gravity = 0;
   double plastic = 0, damage = 0, damping = 0, walls = 0;  // dissipated so far
