@@ -2,12 +2,18 @@
 // Constitutive models. A material updates the stress of its own particles from
 // their velocity gradient over one step; the solver calls it once per material
 // and step, never per particle, so the particle loop has no virtual call.
+//
+// Each model lives in its own file under mpm_solid/materials/: its class, the
+// reader of its scene keys and its registration (register_material), so that
+// a new model is one file and its test.
 
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
+#include "common/scene.hpp"
 #include "mpm_solid/particles.hpp"
 
 namespace outburst::mpm {
@@ -67,23 +73,46 @@ class Material {
   Elasticity elasticity_;
 };
 
-// Linear elasticity with the Jaumann stress rate, plane strain.
-class LinearElastic final : public Material {
- public:
-  using Material::Material;
-  Dissipation update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const override;
+// What a model's reader has beyond its own keys: the material's name and the
+// elasticity every model reads, and the grid's cell size [m].
+struct MaterialContext {
+  std::string name;
+  Elasticity elasticity;
+  double cell_size;
 };
+
+// A constitutive model a scene can name (`model = "<name>"` in
+// [[mpm.materials]]): the reader takes the material's table, reads the
+// model's own keys with located errors and returns the material.
+struct MaterialModel {
+  std::string_view name;
+  std::string_view description;  // a few words for the key's help
+  std::unique_ptr<Material> (*read)(const scene::Table& table, const MaterialContext& context);
+};
+
+// The models registered, in a fixed order (by name).
+const std::vector<MaterialModel>& material_models();
+// Adds a model; each model's file calls it once, at static initialisation:
+// `[[maybe_unused]] const bool registered = register_material({...});`.
+// Two models of one name are a programming error (std::logic_error).
+bool register_material(const MaterialModel& model);
 
 // The elastic trial step shared by the elastic-plastic models: Jaumann-rate
 // linear elasticity over dt, in place.
 void elastic_trial(const Elasticity& e, const Mat<2>& velocity_gradient, double dt, Mat<2>& stress,
                    double& stress_zz);
 
-// Drucker-Prager perfect plasticity fitted to Mohr-Coulomb (paper eqs. 36-37):
-//   f = alpha I1/3 + sqrt(J2) - k,   tension positive,
-// with a plastic potential of the same form using the dilation angle (0 by
-// default: plastic flow keeps the volume). Return mapping to the cone, or to
-// its apex when the cone return would overshoot it (hydrostatic tension).
+// Mean stress and deviator of a plane-strain state (zz included in both).
+struct Invariants {
+  double mean;        // I1 / 3
+  Mat<2> deviator;    // in-plane part of s
+  double deviator_zz;
+  double sqrt_j2;
+};
+Invariants invariants(const Mat<2>& s, double s_zz);
+
+// Drucker-Prager cones fitted to Mohr-Coulomb (paper eqs. 36-37):
+//   f = alpha I1/3 + sqrt(J2) - k,   tension positive.
 struct DruckerPragerFit {
   enum class Kind { outer, inner, plane_strain };
   // alpha and k of f = alpha I1/3 + sqrt(J2) - k.
@@ -96,88 +125,34 @@ struct DruckerPragerFit {
 double drucker_prager_return(double alpha, double k, double alpha_dilation, double shear_modulus,
                              double bulk_modulus, Mat<2>& stress, double& stress_zz, double* work_density);
 
-class DruckerPrager final : public Material {
- public:
-  DruckerPrager(std::string name, Elasticity elasticity, double cohesion, double friction_angle,
-                double dilation_angle, DruckerPragerFit::Kind fit);
-  void create_fields(Particles<2>& p) const override {
-    p.need_plastic_strain();
+// Runs update(i), the stress update of particle i returning what it
+// dissipated, over `members` in parallel, after carrying the particle's
+// deformation gradient and volume over the step: one pass over the particles
+// serves kinematics and constitution.
+template <class Update>
+Dissipation each_member(Particles<2>& p, const std::vector<int>& members, double dt, Update&& update) {
+  const int n = static_cast<int>(members.size());
+  double plastic = 0, damage = 0;
+#pragma omp parallel for schedule(static) reduction(+ : plastic, damage)
+  for (int k = 0; k < n; ++k) {
+    const int i = members[k];
+    p.deformation[i] = (Mat<2>::Identity() + dt * p.velocity_gradient[i]) * p.deformation[i];
+    p.volume[i] = p.volume0[i] * p.deformation[i].determinant();
+    const Dissipation d = update(i);
+    plastic += d.plastic;
+    damage += d.damage;
   }
-  Dissipation update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const override;
+  return {plastic, damage};
+}
 
-  double alpha() const { return alpha_; }
-  double k() const { return k_; }
-  // The yield function of a plane-strain stress state.
-  double yield(const Mat<2>& stress, double stress_zz) const;
-  // Return the trial stress to the yield surface; returns the plastic multiplier
-  // and, if asked, the plastic work density of the return [J/m^3].
-  double return_map(Mat<2>& stress, double& stress_zz, double* work_density = nullptr) const;
-
- private:
-  double alpha_, k_, alpha_dilation_;
-};
-
-// The elastic-damage law of RFPA-type models (model-notes section 3, paper
-// eqs. 10-14), made to leave fragmented coal behind rather than nothing:
-//  - the undamaged (effective) stress sigma~ follows Jaumann-rate elasticity
-//    with E0; damage is read from its principal stresses and strains;
-//  - tensile damage once the largest principal stress reaches f_t:
-//    D = 1 - f_tr / (E0 eps_1) up to eps_1 = eta f_t / E0, then D = 1;
-//  - shear damage once Mohr-Coulomb (c, phi) is reached:
-//    D = 1 - f_cr / (E0 |eps_3|), f_cr the residual share of the UCS;
-//  - D never decreases. The stress acting is sigma~ with its tensile principal
-//    parts scaled by (1 - D) (open cracks carry no tension) and its compressive
-//    parts kept (closed cracks carry compression); compressive states are
-//    bounded by Drucker-Prager friction with cohesion (1 - D) c: fully damaged
-//    coal is cohesionless, tension-free granular material that still piles up
-//    and rubs.
-// The energy stored is half the acting stress times the strain,
-// sigma : C0^-1 : sigma~ / 2; what damage growth at fixed strain takes from it
-// is booked as dissipated by damage.
-struct DamageParameters {
-  double cohesion;          // c [Pa]
-  double friction_angle;    // phi [rad]
-  double tensile_strength;  // f_t [Pa]
-  double residual_ratio;    // f_tr / f_t = f_cr / f_c
-  double ultimate_ratio;    // eta = eps_tu / eps_t0, unless a fracture energy is given
-  // Crack band: with a fracture energy G_f [J/m2] the ultimate tensile strain
-  // is set so that a band band_width [m] wide dissipates G_f per unit crack
-  // area, whatever the resolution: band_width times the area under the
-  // softening law, f_t eps_t0 / 2 + f_tr (eps_tu - eps_t0), equals G_f. A band
-  // too wide for that (the peak alone would dissipate more) is refused when
-  // the scene is read (largest_band_width).
-  std::optional<double> fracture_energy;
-  double band_width = 0;
-  // Largest volume of fully damaged material over its initial volume. Broken
-  // coal bulks to a loose heap; beyond that its fragments part and the gaps are
-  // no part of any particle. Without the cap a fragment's volume grows with
-  // the separation, its density (and the force it exerts per unit mass on
-  // recontact) with it, and the stable step shrinks without bound.
-  double bulking_factor = 1.5;
-};
-
-// The widest crack band a fracture energy allows with elasticity e: the one
-// whose peak alone, f_t^2 / (2 E0) per unit volume, dissipates G_f [m].
-double largest_band_width(const DamageParameters& d, const Elasticity& e);
-
-class ElasticDamage final : public Material {
- public:
-  ElasticDamage(std::string name, Elasticity elasticity, DamageParameters damage);
-  void create_fields(Particles<2>& p) const override {
-    p.need_plastic_strain();
-    p.need_damage();
-  }
-  Dissipation update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const override;
-  // Damage of one particle, given its history value and effective stress.
-  double damage(double previous, const Mat<2>& effective, double effective_zz) const;
-  const DamageParameters& parameters() const { return parameters_; }
-  double strain_energy(const Particles<2>& p, const std::vector<int>& members) const override;
-
- private:
-  DamageParameters parameters_;
-  double ultimate_strain_;  // eps_tu: from eta, or from G_f and the band width
-  double alpha_, k0_;       // Drucker-Prager friction cone (outer fit), intact cohesion
-  double sin_phi_, cos_phi_, ucs_;  // of the Mohr-Coulomb shear criterion
-};
+// Sum of f(i) over the members, in parallel.
+template <class F>
+double sum_over(const std::vector<int>& members, F&& f) {
+  const int n = static_cast<int>(members.size());
+  double sum = 0;
+#pragma omp parallel for schedule(static) reduction(+ : sum)
+  for (int k = 0; k < n; ++k) sum += f(members[k]);
+  return sum;
+}
 
 }  // namespace outburst::mpm

@@ -273,79 +273,20 @@ Setup read_setup(const scene::Table& s) {
     const std::string name = m.string({"name", "material name"});
     if (std::find(names.begin(), names.end(), name) != names.end())
       m.fail("name", fmt::format("material \"{}\" is defined twice", name));
-    const std::string model = m.choice(
-        {"model", "\"elastic\" (Jaumann rate), \"drucker_prager\" (perfectly plastic) or \"elastic_damage\" "
-                  "(brittle, leaving granular fragments)",
-         "elastic"},
-        {"elastic", "drucker_prager", "elastic_damage"});
+    std::vector<std::string_view> models;
+    std::string described;
+    for (const auto& model : material_models()) {
+      models.push_back(model.name);
+      described += fmt::format("{}\"{}\" ({})", described.empty() ? "" : ", ", model.name, model.description);
+    }
+    const std::string model = m.choice({"model", described, "elastic"}, models);
     Elasticity e{};
     e.density = m.quantity({"density", "mass density", "", Range::positive()}, units::density);
     e.youngs_modulus = m.quantity({"youngs_modulus", "Young's modulus E", "", Range::positive()}, units::pressure);
     e.poisson_ratio = m.number({"poisson_ratio", "Poisson's ratio", "", Range{-1.0, 0.5, false, false}});
-    if (model == "elastic") {
-      setup.materials.push_back(std::make_unique<LinearElastic>(name, e));
-    } else if (model == "elastic_damage") {
-      DamageParameters d{};
-      d.cohesion = m.quantity({"cohesion", "Mohr-Coulomb cohesion c of the intact coal", "", Range::positive()},
-                              units::pressure);
-      d.friction_angle = m.quantity({"friction_angle", "Mohr-Coulomb friction angle (also of the fragments)", "",
-                                     Range{0.0, 1.5, true, false}},
-                                    units::angle);
-      d.tensile_strength = m.quantity({"tensile_strength", "tensile strength f_t", "", Range::positive()},
-                                      units::pressure);
-      d.residual_ratio = m.number({"residual_ratio", "residual strength / strength, in tension and compression "
-                                                     "(the paper gives none; 0.1 is common for RFPA models)",
-                                   "0.1", Range{0.0, 1.0, true, false}});
-      if (m.has("fracture_energy")) {
-        // Crack band: the ultimate strain follows from G_f and the grid's cell,
-        // the narrowest band the grid's velocity field can open.
-        if (m.has("ultimate_strain_ratio"))
-          m.fail("ultimate_strain_ratio", "give the ultimate strain ratio (the paper's local law) or a "
-                                          "fracture_energy (a crack band), not both");
-        d.fracture_energy = m.quantity({"fracture_energy", "G_f, energy per unit crack area dissipated in tension: "
-                                                           "a crack band one grid cell wide softens so that it "
-                                                           "dissipates G_f whatever the cell size (K_Ic^2 / E)",
-                                        "", Range::positive()},
-                                       units::energy_per_area);
-        d.band_width = setup.grid.h;
-        if (d.residual_ratio == 0)
-          m.fail("residual_ratio", "a crack band softens along the residual strength: give residual_ratio > 0");
-        if (const double widest = largest_band_width(d, e); d.band_width > widest)
-          m.refuse("fracture_energy",
-                   fmt::format("cells of {:g} m are too coarse for a crack band with G_f = {:g} J/m2: the peak alone, "
-                               "f_t^2 / (2 E), would dissipate more in a cell than G_f allows; refine "
-                               "mpm.grid.cell_size to at most 2 E G_f / f_t^2 = {:.4g} m, or raise G_f",
-                               d.band_width, *d.fracture_energy, widest));
-      } else {
-        d.ultimate_ratio = m.number({"ultimate_strain_ratio", "eta = ultimate tensile strain / strain at f_t, beyond "
-                                                              "which D = 1 (the paper gives none; 5-10 is common); "
-                                                              "or give a fracture_energy",
-                                     "5", Range::at_least(1)});
-      }
-      d.bulking_factor = m.number({"bulking_factor", "largest volume of fully damaged coal over its volume at t = 0: "
-                                                     "broken coal bulks to a loose heap, its fragments then part "
-                                                     "(1.3-1.6 is typical of broken coal)",
-                                   "1.5", Range::at_least(1)});
-      setup.materials.push_back(std::make_unique<ElasticDamage>(name, e, d));
-    } else {
-      const double c = m.quantity({"cohesion", "Mohr-Coulomb cohesion c", "", Range::non_negative()}, units::pressure);
-      const double phi = m.quantity({"friction_angle", "Mohr-Coulomb friction angle", "",
-                                     Range{0.0, 1.5, true, false}},
-                                    units::angle);
-      const double psi = m.quantity({"dilation_angle", "dilation angle of the plastic potential (0: no volume "
-                                                       "change in plastic flow)",
-                                     "0 deg", Range::non_negative()},
-                                    units::angle);
-      if (psi > phi) m.fail("dilation_angle", "must not exceed the friction angle");
-      const auto kind = m.choice<DruckerPragerFit::Kind>(
-          {"fit", "Drucker-Prager cone fitted to Mohr-Coulomb: \"outer\" (compression corners, the paper's), "
-                  "\"inner\" or \"plane_strain\"",
-           "outer"},
-          {{"outer", DruckerPragerFit::Kind::outer},
-           {"inner", DruckerPragerFit::Kind::inner},
-           {"plane_strain", DruckerPragerFit::Kind::plane_strain}});
-      setup.materials.push_back(std::make_unique<DruckerPrager>(name, e, c, phi, psi, kind));
-    }
+    const auto& reader = *std::find_if(material_models().begin(), material_models().end(),
+                                       [&](const MaterialModel& candidate) { return candidate.name == model; });
+    setup.materials.push_back(reader.read(m, {name, e, setup.grid.h}));
     names.push_back(name);
   }
   if (names.empty()) s.fail("materials", "give at least one [[mpm.materials]]");

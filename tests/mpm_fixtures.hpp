@@ -3,6 +3,7 @@
 
 #include <memory>
 
+#include "mpm_solid/materials/elastic.hpp"
 #include "mpm_solid/scene_reader.hpp"
 #include "mpm_solid/solver.hpp"
 

@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "convergence.hpp"
+#include "mpm_solid/materials/elastic.hpp"
 #include "mpm_solid/solver.hpp"
 
 using namespace outburst;

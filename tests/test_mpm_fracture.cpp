@@ -11,6 +11,7 @@
 #include <cstdio>
 
 #include "mpm_fixtures.hpp"
+#include "mpm_solid/materials/elastic_damage.hpp"
 
 using namespace outburst;
 using namespace outburst::mpm;

@@ -4,7 +4,9 @@
 
 #include <cmath>
 
-#include "mpm_solid/material.hpp"
+#include "mpm_solid/materials/drucker_prager.hpp"
+#include "mpm_solid/materials/elastic.hpp"
+#include "mpm_solid/materials/elastic_damage.hpp"
 
 using namespace outburst;
 using namespace outburst::mpm;

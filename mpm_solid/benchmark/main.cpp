@@ -19,6 +19,9 @@
 #include <cstdlib>
 #include <string>
 
+#include "mpm_solid/materials/drucker_prager.hpp"
+#include "mpm_solid/materials/elastic.hpp"
+#include "mpm_solid/materials/elastic_damage.hpp"
 #include "mpm_solid/scene_reader.hpp"
 #include "mpm_solid/solver.hpp"
 

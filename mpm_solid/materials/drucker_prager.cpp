@@ -1,0 +1,67 @@
+#include "mpm_solid/materials/drucker_prager.hpp"
+
+#include <cmath>
+#include <tuple>
+
+namespace outburst::mpm {
+
+DruckerPrager::DruckerPrager(std::string name, Elasticity elasticity, double cohesion, double friction_angle,
+                             double dilation_angle, DruckerPragerFit::Kind fit)
+    : Material(std::move(name), elasticity) {
+  std::tie(alpha_, k_) = DruckerPragerFit::coefficients(fit, cohesion, friction_angle);
+  alpha_dilation_ = DruckerPragerFit::coefficients(fit, 0.0, dilation_angle).first;
+}
+
+double DruckerPrager::yield(const Mat<2>& s, double s_zz) const {
+  const auto inv = invariants(s, s_zz);
+  return alpha_ * inv.mean + inv.sqrt_j2 - k_;
+}
+
+double DruckerPrager::return_map(Mat<2>& s, double& s_zz, double* work_density) const {
+  const double g = elasticity().shear_modulus();
+  return drucker_prager_return(alpha_, k_, alpha_dilation_, g, elasticity().lame_lambda() + 2.0 / 3.0 * g, s, s_zz,
+                               work_density);
+}
+
+Dissipation DruckerPrager::update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const {
+  // Equivalent plastic strain per unit multiplier: sqrt(2/3 |dg/dsigma|^2).
+  const double strain_per_multiplier = std::sqrt(2.0 / 3.0 * (0.5 + alpha_dilation_ * alpha_dilation_ / 3));
+  return each_member(p, members, dt, [&](int i) {
+    elastic_trial(elasticity(), p.velocity_gradient[i], dt, p.stress[i], p.stress_zz[i]);
+    double work = 0;
+    const double multiplier = return_map(p.stress[i], p.stress_zz[i], &work);
+    if (multiplier == 0) return Dissipation{};
+    p.plastic_strain[i] += strain_per_multiplier * multiplier;
+    return Dissipation{p.volume[i] * work, 0};
+  });
+}
+
+namespace {
+
+using scene::Range;
+
+std::unique_ptr<Material> read(const scene::Table& m, const MaterialContext& context) {
+  const double c = m.quantity({"cohesion", "Mohr-Coulomb cohesion c", "", Range::non_negative()}, units::pressure);
+  const double phi = m.quantity({"friction_angle", "Mohr-Coulomb friction angle", "",
+                                 Range{0.0, 1.5, true, false}},
+                                units::angle);
+  const double psi = m.quantity({"dilation_angle", "dilation angle of the plastic potential (0: no volume "
+                                                   "change in plastic flow)",
+                                 "0 deg", Range::non_negative()},
+                                units::angle);
+  if (psi > phi) m.fail("dilation_angle", "must not exceed the friction angle");
+  const auto kind = m.choice<DruckerPragerFit::Kind>(
+      {"fit", "Drucker-Prager cone fitted to Mohr-Coulomb: \"outer\" (compression corners, the paper's), "
+              "\"inner\" or \"plane_strain\"",
+       "outer"},
+      {{"outer", DruckerPragerFit::Kind::outer},
+       {"inner", DruckerPragerFit::Kind::inner},
+       {"plane_strain", DruckerPragerFit::Kind::plane_strain}});
+  return std::make_unique<DruckerPrager>(context.name, context.elasticity, c, phi, psi, kind);
+}
+
+[[maybe_unused]] const bool registered = register_material({"drucker_prager", "perfectly plastic", read});
+
+}  // namespace
+
+}  // namespace outburst::mpm

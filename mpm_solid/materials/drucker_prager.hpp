@@ -1,0 +1,32 @@
+#pragma once
+#include "mpm_solid/material.hpp"
+
+namespace outburst::mpm {
+
+// Drucker-Prager perfect plasticity fitted to Mohr-Coulomb (paper eqs. 36-37):
+//   f = alpha I1/3 + sqrt(J2) - k,   tension positive,
+// with a plastic potential of the same form using the dilation angle (0 by
+// default: plastic flow keeps the volume). Return mapping to the cone, or to
+// its apex when the cone return would overshoot it (hydrostatic tension).
+class DruckerPrager final : public Material {
+ public:
+  DruckerPrager(std::string name, Elasticity elasticity, double cohesion, double friction_angle,
+                double dilation_angle, DruckerPragerFit::Kind fit);
+  void create_fields(Particles<2>& p) const override {
+    p.need_plastic_strain();
+  }
+  Dissipation update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const override;
+
+  double alpha() const { return alpha_; }
+  double k() const { return k_; }
+  // The yield function of a plane-strain stress state.
+  double yield(const Mat<2>& stress, double stress_zz) const;
+  // Return the trial stress to the yield surface; returns the plastic multiplier
+  // and, if asked, the plastic work density of the return [J/m^3].
+  double return_map(Mat<2>& stress, double& stress_zz, double* work_density = nullptr) const;
+
+ private:
+  double alpha_, k_, alpha_dilation_;
+};
+
+}  // namespace outburst::mpm

@@ -1,0 +1,13 @@
+#pragma once
+#include "mpm_solid/material.hpp"
+
+namespace outburst::mpm {
+
+// Linear elasticity with the Jaumann stress rate, plane strain.
+class LinearElastic final : public Material {
+ public:
+  using Material::Material;
+  Dissipation update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const override;
+};
+
+}  // namespace outburst::mpm

@@ -1,0 +1,199 @@
+#include "mpm_solid/materials/elastic_damage.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <tuple>
+
+#include <fmt/format.h>
+
+namespace outburst::mpm {
+
+namespace {
+
+// In-plane principal values (a >= b) and the unit vector of a.
+struct Principal {
+  double a, b;
+  Vec<2> direction;
+};
+
+Principal principal(const Mat<2>& s) {
+  const double centre = 0.5 * (s(0, 0) + s(1, 1));
+  const double half = 0.5 * (s(0, 0) - s(1, 1));
+  const double radius = std::sqrt(half * half + s(0, 1) * s(0, 1));
+  if (radius == 0) return {centre, centre, Vec<2>(1, 0)};
+  // Half-angle formulas from cos 2t = half / radius, sin 2t = s_xy / radius:
+  // no trigonometric calls in the innermost loop of the damage law.
+  const double cos2 = half / radius;
+  const double c = std::sqrt(0.5 * (1 + cos2)), sn = std::copysign(std::sqrt(0.5 * (1 - cos2)), s(0, 1));
+  return {centre + radius, centre - radius, Vec<2>(c, sn)};
+}
+
+Mat<2> compose(double a, double b, const Vec<2>& direction) {
+  const Vec<2> normal(-direction.y(), direction.x());
+  return a * direction * direction.transpose() + b * normal * normal.transpose();
+}
+
+// Open cracks: tensile principal parts scaled by (1 - D) (or back, by 1/(1 - D)).
+double crack(double principal_value, double factor) {
+  return principal_value > 0 ? factor * principal_value : principal_value;
+}
+
+}  // namespace
+
+double largest_band_width(const DamageParameters& d, const Elasticity& e) {
+  return d.fracture_energy ? 2 * e.youngs_modulus * *d.fracture_energy / (d.tensile_strength * d.tensile_strength)
+                           : std::numeric_limits<double>::infinity();
+}
+
+ElasticDamage::ElasticDamage(std::string name, Elasticity elasticity, DamageParameters damage)
+    : Material(std::move(name), elasticity), parameters_(damage) {
+  const double eps_t0 = damage.tensile_strength / elasticity.youngs_modulus;
+  if (!damage.fracture_energy) {
+    ultimate_strain_ = damage.ultimate_ratio * eps_t0;
+  } else {
+    if (!(damage.band_width > 0 && damage.band_width <= largest_band_width(damage, elasticity) &&
+          damage.residual_ratio > 0))
+      throw std::invalid_argument(fmt::format(
+          "material \"{}\": a crack band of {:g} m with G_f = {:g} J/m2 and a residual ratio of {:g} cannot hold",
+          this->name(), damage.band_width, *damage.fracture_energy, damage.residual_ratio));
+    const double per_volume = *damage.fracture_energy / damage.band_width;
+    ultimate_strain_ =
+        eps_t0 + (per_volume - 0.5 * damage.tensile_strength * eps_t0) / (damage.residual_ratio * damage.tensile_strength);
+  }
+  std::tie(alpha_, k0_) =
+      DruckerPragerFit::coefficients(DruckerPragerFit::Kind::outer, damage.cohesion, damage.friction_angle);
+  sin_phi_ = std::sin(damage.friction_angle);
+  cos_phi_ = std::cos(damage.friction_angle);
+  ucs_ = 2 * damage.cohesion * cos_phi_ / (1 - sin_phi_);
+}
+
+double ElasticDamage::damage(double previous, const Mat<2>& effective, double effective_zz) const {
+  const auto& d = parameters_;
+  const double e0 = elasticity().youngs_modulus, nu = elasticity().poisson_ratio;
+  const Principal pr = principal(effective);
+  const double s1 = std::max(pr.a, effective_zz), s3 = std::min(pr.b, effective_zz);
+  const double s2 = pr.a + pr.b + effective_zz - s1 - s3;
+  const auto strain = [&](double si, double sj, double sk) { return (si - nu * (sj + sk)) / e0; };
+  double damage = previous;
+  if (s1 >= d.tensile_strength) {
+    const double eps1 = strain(s1, s2, s3);
+    const double tensile =
+        eps1 >= ultimate_strain_ ? 1.0 : 1 - d.residual_ratio * d.tensile_strength / (e0 * eps1);
+    damage = std::max(damage, tensile);
+  }
+  if (0.5 * (s1 - s3) >= d.cohesion * cos_phi_ - 0.5 * (s1 + s3) * sin_phi_) {
+    const double eps3 = strain(s3, s1, s2);
+    if (eps3 < 0) damage = std::max(damage, 1 - d.residual_ratio * ucs_ / (e0 * -eps3));
+  }
+  return std::clamp(damage, 0.0, 1.0);
+}
+
+Dissipation ElasticDamage::update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const {
+  const double g = elasticity().shear_modulus(), bulk = elasticity().lame_lambda() + 2.0 / 3.0 * g;
+  return each_member(p, members, dt, [&](int i) {
+    Dissipation dissipated;
+    Mat<2>& effective = p.effective_stress[i];
+    double& effective_zz = p.effective_stress_zz[i];
+    elastic_trial(elasticity(), p.velocity_gradient[i], dt, effective, effective_zz);
+    const double previous = p.damage[i];
+    const double d = damage(previous, effective, effective_zz);
+    p.damage[i] = d;
+    // The stress acting: open cracks carry no share of tension.
+    const Principal pr = principal(effective);
+    Mat<2> s = compose(crack(pr.a, 1 - d), crack(pr.b, 1 - d), pr.direction);
+    double s_zz = crack(effective_zz, 1 - d);
+    if (d > previous) {
+      // Y dD: the energy the cracks take at the strain they opened at.
+      const Mat<2> before = compose(crack(pr.a, 1 - previous), crack(pr.b, 1 - previous), pr.direction);
+      const double before_zz = crack(effective_zz, 1 - previous);
+      dissipated.damage = 0.5 * p.volume[i] *
+                          (compliance_product(before, before_zz, effective, effective_zz) -
+                           compliance_product(s, s_zz, effective, effective_zz));
+    }
+    // Friction bounds compressive states, with the cohesion the cracks leave;
+    // tension is the damage law's to soften (a cone there would cap the elastic
+    // strain the damage is read from).
+    double work = 0;
+    const bool compressive = s.trace() + s_zz < 0;
+    if (const double multiplier =
+            compressive ? drucker_prager_return(alpha_, (1 - d) * k0_, 0.0, g, bulk, s, s_zz, &work) : 0.0;
+        multiplier > 0) {
+      p.plastic_strain[i] += multiplier / std::sqrt(3.0);  // no dilation: sqrt(2/3 |dg/dsigma|^2) = 1/sqrt(3)
+      dissipated.plastic = p.volume[i] * work;
+      // Carry the return back to the undamaged stress (same principal axes).
+      const Principal back = principal(s);
+      const double open = d < 1 ? 1 / (1 - d) : 0.0;
+      effective = compose(crack(back.a, open), crack(back.b, open), back.direction);
+      effective_zz = crack(s_zz, open);
+    }
+    p.stress[i] = s;
+    p.stress_zz[i] = s_zz;
+    if (d >= 1) p.volume[i] = std::min(p.volume[i], parameters_.bulking_factor * p.volume0[i]);
+    return dissipated;
+  });
+}
+
+double ElasticDamage::strain_energy(const Particles<2>& p, const std::vector<int>& members) const {
+  return sum_over(members, [&](int i) {
+    return 0.5 * p.volume[i] *
+           compliance_product(p.stress[i], p.stress_zz[i], p.effective_stress[i], p.effective_stress_zz[i]);
+  });
+}
+
+namespace {
+
+using scene::Range;
+
+std::unique_ptr<Material> read(const scene::Table& m, const MaterialContext& c) {
+  DamageParameters d{};
+  d.cohesion = m.quantity({"cohesion", "Mohr-Coulomb cohesion c of the intact coal", "", Range::positive()},
+                          units::pressure);
+  d.friction_angle = m.quantity({"friction_angle", "Mohr-Coulomb friction angle (also of the fragments)", "",
+                                 Range{0.0, 1.5, true, false}},
+                                units::angle);
+  d.tensile_strength = m.quantity({"tensile_strength", "tensile strength f_t", "", Range::positive()},
+                                  units::pressure);
+  d.residual_ratio = m.number({"residual_ratio", "residual strength / strength, in tension and compression "
+                                                 "(the paper gives none; 0.1 is common for RFPA models)",
+                               "0.1", Range{0.0, 1.0, true, false}});
+  if (m.has("fracture_energy")) {
+    // Crack band: the ultimate strain follows from G_f and the grid's cell,
+    // the narrowest band the grid's velocity field can open.
+    if (m.has("ultimate_strain_ratio"))
+      m.fail("ultimate_strain_ratio", "give the ultimate strain ratio (the paper's local law) or a "
+                                      "fracture_energy (a crack band), not both");
+    d.fracture_energy = m.quantity({"fracture_energy", "G_f, energy per unit crack area dissipated in tension: "
+                                                       "a crack band one grid cell wide softens so that it "
+                                                       "dissipates G_f whatever the cell size (K_Ic^2 / E)",
+                                    "", Range::positive()},
+                                   units::energy_per_area);
+    d.band_width = c.cell_size;
+    if (d.residual_ratio == 0)
+      m.fail("residual_ratio", "a crack band softens along the residual strength: give residual_ratio > 0");
+    if (const double widest = largest_band_width(d, c.elasticity); d.band_width > widest)
+      m.refuse("fracture_energy",
+               fmt::format("cells of {:g} m are too coarse for a crack band with G_f = {:g} J/m2: the peak alone, "
+                           "f_t^2 / (2 E), would dissipate more in a cell than G_f allows; refine "
+                           "mpm.grid.cell_size to at most 2 E G_f / f_t^2 = {:.4g} m, or raise G_f",
+                           d.band_width, *d.fracture_energy, widest));
+  } else {
+    d.ultimate_ratio = m.number({"ultimate_strain_ratio", "eta = ultimate tensile strain / strain at f_t, beyond "
+                                                          "which D = 1 (the paper gives none; 5-10 is common); "
+                                                          "or give a fracture_energy",
+                                 "5", Range::at_least(1)});
+  }
+  d.bulking_factor = m.number({"bulking_factor", "largest volume of fully damaged coal over its volume at t = 0: "
+                                                 "broken coal bulks to a loose heap, its fragments then part "
+                                                 "(1.3-1.6 is typical of broken coal)",
+                               "1.5", Range::at_least(1)});
+  return std::make_unique<ElasticDamage>(c.name, c.elasticity, d);
+}
+
+[[maybe_unused]] const bool registered =
+    register_material({"elastic_damage", "brittle, leaving granular fragments", read});
+
+}  // namespace
+
+}  // namespace outburst::mpm

@@ -1,0 +1,69 @@
+#pragma once
+#include "mpm_solid/material.hpp"
+
+namespace outburst::mpm {
+
+// The elastic-damage law of RFPA-type models (model-notes section 3, paper
+// eqs. 10-14), made to leave fragmented coal behind rather than nothing:
+//  - the undamaged (effective) stress sigma~ follows Jaumann-rate elasticity
+//    with E0; damage is read from its principal stresses and strains;
+//  - tensile damage once the largest principal stress reaches f_t:
+//    D = 1 - f_tr / (E0 eps_1) up to eps_1 = eta f_t / E0, then D = 1;
+//  - shear damage once Mohr-Coulomb (c, phi) is reached:
+//    D = 1 - f_cr / (E0 |eps_3|), f_cr the residual share of the UCS;
+//  - D never decreases. The stress acting is sigma~ with its tensile principal
+//    parts scaled by (1 - D) (open cracks carry no tension) and its compressive
+//    parts kept (closed cracks carry compression); compressive states are
+//    bounded by Drucker-Prager friction with cohesion (1 - D) c: fully damaged
+//    coal is cohesionless, tension-free granular material that still piles up
+//    and rubs.
+// The energy stored is half the acting stress times the strain,
+// sigma : C0^-1 : sigma~ / 2; what damage growth at fixed strain takes from it
+// is booked as dissipated by damage.
+struct DamageParameters {
+  double cohesion;          // c [Pa]
+  double friction_angle;    // phi [rad]
+  double tensile_strength;  // f_t [Pa]
+  double residual_ratio;    // f_tr / f_t = f_cr / f_c
+  double ultimate_ratio;    // eta = eps_tu / eps_t0, unless a fracture energy is given
+  // Crack band: with a fracture energy G_f [J/m2] the ultimate tensile strain
+  // is set so that a band band_width [m] wide dissipates G_f per unit crack
+  // area, whatever the resolution: band_width times the area under the
+  // softening law, f_t eps_t0 / 2 + f_tr (eps_tu - eps_t0), equals G_f. A band
+  // too wide for that (the peak alone would dissipate more) is refused when
+  // the scene is read (largest_band_width).
+  std::optional<double> fracture_energy;
+  double band_width = 0;
+  // Largest volume of fully damaged material over its initial volume. Broken
+  // coal bulks to a loose heap; beyond that its fragments part and the gaps are
+  // no part of any particle. Without the cap a fragment's volume grows with
+  // the separation, its density (and the force it exerts per unit mass on
+  // recontact) with it, and the stable step shrinks without bound.
+  double bulking_factor = 1.5;
+};
+
+// The widest crack band a fracture energy allows with elasticity e: the one
+// whose peak alone, f_t^2 / (2 E0) per unit volume, dissipates G_f [m].
+double largest_band_width(const DamageParameters& d, const Elasticity& e);
+
+class ElasticDamage final : public Material {
+ public:
+  ElasticDamage(std::string name, Elasticity elasticity, DamageParameters damage);
+  void create_fields(Particles<2>& p) const override {
+    p.need_plastic_strain();
+    p.need_damage();
+  }
+  Dissipation update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const override;
+  // Damage of one particle, given its history value and effective stress.
+  double damage(double previous, const Mat<2>& effective, double effective_zz) const;
+  const DamageParameters& parameters() const { return parameters_; }
+  double strain_energy(const Particles<2>& p, const std::vector<int>& members) const override;
+
+ private:
+  DamageParameters parameters_;
+  double ultimate_strain_;  // eps_tu: from eta, or from G_f and the band width
+  double alpha_, k0_;       // Drucker-Prager friction cone (outer fit), intact cohesion
+  double sin_phi_, cos_phi_, ucs_;  // of the Mohr-Coulomb shear criterion
+};
+
+}  // namespace outburst::mpm
