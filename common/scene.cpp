@@ -553,8 +553,9 @@ std::vector<T> Table::integer_vector(const Key& key, std::size_t count) const {
   return {values.begin(), values.end()};
 }
 
-// The programs store their integer keys as int.
+// The programs store their integer keys as int; seeds as 64-bit integers.
 template int Table::integer<int>(const Key&) const;
+template std::int64_t Table::integer<std::int64_t>(const Key&) const;
 template std::vector<int> Table::integer_vector<int>(const Key&, std::size_t) const;
 
 std::vector<double> Table::number_vector(const Key& key, std::size_t count) const {

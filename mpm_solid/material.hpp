@@ -52,8 +52,9 @@ class Material {
   const Elasticity& elasticity() const { return elasticity_; }
 
   // Creates the optional particle fields the model keeps (plastic strain,
-  // damage); the solver calls it before the first step.
-  virtual void create_fields(Particles<2>&) const {}
+  // damage) and sets those of its own particles, `members`; the solver calls
+  // it before the first step.
+  virtual void create_fields(Particles<2>&, const std::vector<int>& /*members*/) const {}
 
   // Update the stresses of particles `members` over a step dt from their
   // velocity gradients (objective: Jaumann rate, paper eqs. 31-33), and carry

@@ -93,6 +93,8 @@ void Output::snapshot(const Solver& solver) {
   snap.add("particles", {"plastic_strain", output::Center::node, 1, "", std::move(plastic)});
   snap.add("particles", {"material", output::Center::node, 1, "", std::move(material)});
   snap.add("particles", {"id", output::Center::node, 1, "", std::move(id)});
+  if (!p.strength_scale.empty())
+    snap.add("particles", {"strength_scale", output::Center::node, 1, "", p.strength_scale});
   series_.write(snap);
 }
 

@@ -42,6 +42,9 @@ struct Particles {
   std::vector<double> damage;               // D in [0, 1], irreversible (damage materials)
   std::vector<Mat<Dim>> effective_stress;   // undamaged stress sigma~ (damage materials)
   std::vector<double> effective_stress_zz;
+  // Factor on a heterogeneous material's strengths, drawn per particle (1
+  // elsewhere).
+  std::vector<double> strength_scale;
 
   // The field table: every field above once, with its checkpoint name and,
   // for an optional one, the effect that creates it and the field it starts
@@ -71,7 +74,8 @@ struct Particles {
         Field<double>{"plastic_strain", &P::plastic_strain, "plasticity"},
         Field<double>{"damage", &P::damage, "damage"},
         Field<Mat<Dim>>{"effective_stress", &P::effective_stress, "damage", &P::stress},
-        Field<double>{"effective_stress_zz", &P::effective_stress_zz, "damage", &P::stress_zz});
+        Field<double>{"effective_stress_zz", &P::effective_stress_zz, "damage", &P::stress_zz},
+        Field<double>{"strength_scale", &P::strength_scale, "heterogeneity"});
   }
   template <class F>
   void for_each_field(F&& f) {

@@ -119,8 +119,8 @@ Solver::Solver(Grid<2> grid, std::vector<std::unique_ptr<Material>> materials,
   empty_node_mass_ = settings_.empty_node_mass_fraction * total_mass / static_cast<double>(particles_.size());
   refuse_in_lean_build(settings_.gravity.squaredNorm() > 0, "gravity");
   refuse_in_lean_build(!particles_.surface_force.empty(), "tractions");
-  for (const auto& m : materials_) m->create_fields(particles_);
   rebuild_material_groups();
+  for (std::size_t m = 0; m < materials_.size(); ++m) materials_[m]->create_fields(particles_, members_[m]);
   find_obstacle_nodes();
   for (const Platen& platen : settings_.platens) {
     if (!(platen.upper.array() > platen.lower.array()).all())

@@ -2,6 +2,7 @@
 // answers: one particle driven by a prescribed velocity gradient.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 
 #include "mpm_solid/materials/drucker_prager.hpp"
@@ -225,4 +226,62 @@ TEST_CASE("elastic-damage: broken coal bulks to its bulking factor and no furthe
   drive(m, p, l, 100, 1.0 / 100);  // fragments parting: the deformation says 2.7 x the volume
   CHECK(p.deformation[0].determinant() > 2.5);
   CHECK(p.volume[0] == Approx(coal_damage.bulking_factor * p.volume0[0]).epsilon(1e-12));
+}
+
+TEST_CASE("heterogeneous coal: strength factors follow the Weibull law of the homogeneity index, mean 1, set by the "
+          "seed alone", "[mpm][material][damage][heterogeneity]") {
+  const double shape = GENERATE(1.5, 3.0, 6.0);
+  const DamageParameters::Heterogeneity h{shape, 7}, other{shape, 8};
+  const int n = 20000;
+  std::vector<double> u(n);
+  int same_as_other_seed = 0;
+  for (int id = 0; id < n; ++id) {
+    u[id] = weibull_strength_scale(h, id);
+    REQUIRE(u[id] == weibull_strength_scale(h, id));  // a function of the seed and the id only
+    same_as_other_seed += u[id] == weibull_strength_scale(other, id);
+  }
+  double mean = 0;
+  for (double x : u) mean += x / n;
+  // Kolmogorov-Smirnov distance to F(u) = 1 - exp(-(u / u0)^m), and the shape
+  // fitted to ln(-ln(1 - F)) = m ln u - m ln u0 (Weibull plot).
+  std::sort(u.begin(), u.end());
+  const double u0 = 1 / std::tgamma(1 + 1 / shape);
+  double ks = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;
+  for (int k = 0; k < n; ++k) {
+    const double f = 1 - std::exp(-std::pow(u[k] / u0, shape));
+    ks = std::max({ks, std::abs(f - double(k) / n), std::abs(f - double(k + 1) / n)});
+    const double empirical = (k + 0.5) / n, x = std::log(u[k]), y = std::log(-std::log(1 - empirical));
+    sx += x, sy += y, sxx += x * x, sxy += x * y;
+  }
+  const double fitted = (n * sxy - sx * sy) / (n * sxx - sx * sx);
+  std::printf("\nWeibull m = %g: mean %.4f, fitted shape %.3f, KS distance %.4f, %d of %d draws equal under "
+              "another seed\n",
+              shape, mean, fitted, ks, same_as_other_seed, n);
+  CHECK(mean == Approx(1).epsilon(0.015));
+  CHECK(fitted == Approx(shape).epsilon(0.03));
+  CHECK(ks < 1.63 / std::sqrt(double(n)));  // the 1 % critical value
+  CHECK(same_as_other_seed == 0);
+}
+
+TEST_CASE("heterogeneous coal: a particle's damage starts at its own share of the strength, and only its material's "
+          "particles are drawn", "[mpm][material][damage][heterogeneity]") {
+  DamageParameters d = coal_damage;
+  d.heterogeneity = DamageParameters::Heterogeneity{3.0, 11};
+  ElasticDamage m("coal", coal, d);
+  // Uniaxial tension at 0.6 f_t: intact at a factor of 1, damaged at 0.5.
+  Mat<2> s = Mat<2>::Zero();
+  s(0, 0) = 0.6 * d.tensile_strength;
+  CHECK(m.damage(0, s, 0, 1.0) == 0);
+  CHECK(m.damage(0, s, 0, 0.5) > 0);
+  // The factor scales the whole tensile law: D(scale eps) at scale equals D(eps) at 1.
+  Mat<2> at_one = Mat<2>::Zero(), at_half = Mat<2>::Zero();
+  at_one(0, 0) = 1.5 * d.tensile_strength;
+  at_half(0, 0) = 0.75 * d.tensile_strength;
+  CHECK(m.damage(0, at_half, 0, 0.5) == Approx(m.damage(0, at_one, 0, 1.0)).epsilon(1e-12));
+
+  Particles<2> p;
+  for (int k = 0; k < 6; ++k) p.add({0, 0}, {0, 0}, 1, 1, 0.5, Mat<2>::Zero(), 0, k % 2);
+  m.create_fields(p, {1, 3, 5});
+  for (int k = 0; k < 6; ++k)
+    CHECK(p.strength_scale[k] == (k % 2 ? weibull_strength_scale(*d.heterogeneity, p.id[k]) : 1.0));
 }

@@ -12,7 +12,7 @@ class DruckerPrager final : public Material {
  public:
   DruckerPrager(std::string name, Elasticity elasticity, double cohesion, double friction_angle,
                 double dilation_angle, DruckerPragerFit::Kind fit);
-  void create_fields(Particles<2>& p) const override {
+  void create_fields(Particles<2>& p, const std::vector<int>&) const override {
     p.need_plastic_strain();
   }
   Dissipation update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const override;

@@ -69,7 +69,34 @@ ElasticDamage::ElasticDamage(std::string name, Elasticity elasticity, DamagePara
   ucs_ = 2 * damage.cohesion * cos_phi_ / (1 - sin_phi_);
 }
 
-double ElasticDamage::damage(double previous, const Mat<2>& effective, double effective_zz) const {
+double weibull_strength_scale(const DamageParameters::Heterogeneity& h, std::int64_t id) {
+  // splitmix64 (Steele, Lea & Flood 2014) of the seed and the id: a uniform
+  // draw in [0, 1) that depends on nothing else.
+  const auto mix = [](std::uint64_t z) {
+    z += 0x9e3779b97f4a7c15ULL;
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    return z ^ (z >> 31);
+  };
+  const double uniform = static_cast<double>(mix(h.seed ^ mix(static_cast<std::uint64_t>(id))) >> 11) * 0x1p-53;
+  // Inverse of F(u) = 1 - exp(-(u / u0)^m), with u0 = 1 / Gamma(1 + 1/m) for
+  // a mean of 1.
+  const double u0 = 1 / std::tgamma(1 + 1 / h.homogeneity_index);
+  return u0 * std::pow(-std::log1p(-uniform), 1 / h.homogeneity_index);
+}
+
+void ElasticDamage::create_fields(Particles<2>& p, const std::vector<int>& members) const {
+  p.need_plastic_strain();
+  p.need_damage();
+  if (!parameters_.heterogeneity) return;
+  if (p.strength_scale.empty()) {
+    p.need("heterogeneity");
+    std::fill(p.strength_scale.begin(), p.strength_scale.end(), 1.0);
+  }
+  for (const int i : members) p.strength_scale[i] = weibull_strength_scale(*parameters_.heterogeneity, p.id[i]);
+}
+
+double ElasticDamage::damage(double previous, const Mat<2>& effective, double effective_zz, double scale) const {
   const auto& d = parameters_;
   const double e0 = elasticity().youngs_modulus, nu = elasticity().poisson_ratio;
   const Principal pr = principal(effective);
@@ -77,28 +104,30 @@ double ElasticDamage::damage(double previous, const Mat<2>& effective, double ef
   const double s2 = pr.a + pr.b + effective_zz - s1 - s3;
   const auto strain = [&](double si, double sj, double sk) { return (si - nu * (sj + sk)) / e0; };
   double damage = previous;
-  if (s1 >= d.tensile_strength) {
+  if (s1 >= scale * d.tensile_strength) {
     const double eps1 = strain(s1, s2, s3);
     const double tensile =
-        eps1 >= ultimate_strain_ ? 1.0 : 1 - d.residual_ratio * d.tensile_strength / (e0 * eps1);
+        eps1 >= scale * ultimate_strain_ ? 1.0 : 1 - d.residual_ratio * scale * d.tensile_strength / (e0 * eps1);
     damage = std::max(damage, tensile);
   }
-  if (0.5 * (s1 - s3) >= d.cohesion * cos_phi_ - 0.5 * (s1 + s3) * sin_phi_) {
+  if (0.5 * (s1 - s3) >= scale * d.cohesion * cos_phi_ - 0.5 * (s1 + s3) * sin_phi_) {
     const double eps3 = strain(s3, s1, s2);
-    if (eps3 < 0) damage = std::max(damage, 1 - d.residual_ratio * ucs_ / (e0 * -eps3));
+    if (eps3 < 0) damage = std::max(damage, 1 - d.residual_ratio * scale * ucs_ / (e0 * -eps3));
   }
   return std::clamp(damage, 0.0, 1.0);
 }
 
 Dissipation ElasticDamage::update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const {
   const double g = elasticity().shear_modulus(), bulk = elasticity().lame_lambda() + 2.0 / 3.0 * g;
+  const bool heterogeneous = parameters_.heterogeneity.has_value();
   return each_member(p, members, dt, [&](int i) {
     Dissipation dissipated;
     Mat<2>& effective = p.effective_stress[i];
     double& effective_zz = p.effective_stress_zz[i];
     elastic_trial(elasticity(), p.velocity_gradient[i], dt, effective, effective_zz);
     const double previous = p.damage[i];
-    const double d = damage(previous, effective, effective_zz);
+    const double scale = heterogeneous ? p.strength_scale[i] : 1.0;
+    const double d = damage(previous, effective, effective_zz, scale);
     p.damage[i] = d;
     // The stress acting: open cracks carry no share of tension.
     const Principal pr = principal(effective);
@@ -118,7 +147,7 @@ Dissipation ElasticDamage::update_stress(Particles<2>& p, const std::vector<int>
     double work = 0;
     const bool compressive = s.trace() + s_zz < 0;
     if (const double multiplier =
-            compressive ? drucker_prager_return(alpha_, (1 - d) * k0_, 0.0, g, bulk, s, s_zz, &work) : 0.0;
+            compressive ? drucker_prager_return(alpha_, (1 - d) * scale * k0_, 0.0, g, bulk, s, s_zz, &work) : 0.0;
         multiplier > 0) {
       p.plastic_strain[i] += multiplier / std::sqrt(3.0);  // no dilation: sqrt(2/3 |dg/dsigma|^2) = 1/sqrt(3)
       dissipated.plastic = p.volume[i] * work;
@@ -188,6 +217,15 @@ std::unique_ptr<Material> read(const scene::Table& m, const MaterialContext& c) 
                                                  "broken coal bulks to a loose heap, its fragments then part "
                                                  "(1.3-1.6 is typical of broken coal)",
                                "1.5", Range::at_least(1)});
+  if (const auto h = m.table("heterogeneity", "heterogeneous coal: each particle's strengths scaled by a Weibull "
+                                               "draw of mean 1 (RFPA's approach)", false)) {
+    d.heterogeneity = DamageParameters::Heterogeneity{
+        h->number({"homogeneity_index", "Weibull shape m: the larger, the more uniform the coal (1.5-5 is "
+                                        "typical of RFPA models of coal and rock)",
+                   "", Range::at_least(1)}),
+        static_cast<std::uint64_t>(h->integer<std::int64_t>(
+            {"seed", "seed of the draw: the same seed, the same coal", "1", Range::non_negative()}))};
+  }
   return std::make_unique<ElasticDamage>(c.name, c.elasticity, d);
 }
 

@@ -1,4 +1,6 @@
 #pragma once
+#include <cstdint>
+
 #include "mpm_solid/material.hpp"
 
 namespace outburst::mpm {
@@ -40,7 +42,23 @@ struct DamageParameters {
   // the separation, its density (and the force it exerts per unit mass on
   // recontact) with it, and the stable step shrinks without bound.
   double bulking_factor = 1.5;
+  // Heterogeneous coal (RFPA's approach: Tang 1997; Xu, Tang et al. 2006): each
+  // particle's strengths f_t and c, and its ultimate strain, scaled by a factor
+  // drawn from a Weibull distribution of shape m (the homogeneity index) and
+  // mean 1. The draw is a hash of the seed and the particle's id: the same
+  // seed gives the same coal whatever the threads or the particle order.
+  // Under a crack band G_f scales with the square of the factor, so every
+  // particle keeps the characteristic length E G_f / f_t^2 and the band's
+  // snap-back limit holds for all alike.
+  struct Heterogeneity {
+    double homogeneity_index;
+    std::uint64_t seed;
+  };
+  std::optional<Heterogeneity> heterogeneity = std::nullopt;
 };
+
+// The strength factor of particle `id`: Weibull with shape m, mean 1.
+double weibull_strength_scale(const DamageParameters::Heterogeneity& h, std::int64_t id);
 
 // The widest crack band a fracture energy allows with elasticity e: the one
 // whose peak alone, f_t^2 / (2 E0) per unit volume, dissipates G_f [m].
@@ -49,13 +67,11 @@ double largest_band_width(const DamageParameters& d, const Elasticity& e);
 class ElasticDamage final : public Material {
  public:
   ElasticDamage(std::string name, Elasticity elasticity, DamageParameters damage);
-  void create_fields(Particles<2>& p) const override {
-    p.need_plastic_strain();
-    p.need_damage();
-  }
+  void create_fields(Particles<2>& p, const std::vector<int>& members) const override;
   Dissipation update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const override;
-  // Damage of one particle, given its history value and effective stress.
-  double damage(double previous, const Mat<2>& effective, double effective_zz) const;
+  // Damage of one particle, given its history value, effective stress and
+  // strength factor.
+  double damage(double previous, const Mat<2>& effective, double effective_zz, double scale = 1.0) const;
   const DamageParameters& parameters() const { return parameters_; }
   double strain_energy(const Particles<2>& p, const std::vector<int>& members) const override;
 
