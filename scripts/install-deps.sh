@@ -16,6 +16,8 @@ packages=(
   # scene files edited by the studies (comments kept); the outburst's finer
   # seepage mesh, meshed from seam.geo by its sensitivity study
   python3-tomlkit gmsh
+  # the ensembles' confidence intervals (Student t)
+  python3-scipy
 )
 
 missing=()

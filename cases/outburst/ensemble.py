@@ -1,0 +1,164 @@
+#!/usr/bin/python3
+"""An ensemble of the outburst case over heterogeneous coal: one run per seed of
+the Weibull draw, side by side, and each headline number's mean, spread and
+95 % confidence interval.
+
+usage: ensemble.py [--outburst build/coupler/outburst] [--out results/outburst_ensemble]
+                   [--seeds 8] [--homogeneity 3] [--end-time "1 s"] [--jobs J]
+                   [--set KEY=VALUE ...] [--resume]
+
+Each run is the shipped case with mpm.materials[0].heterogeneity = {
+homogeneity_index = M, seed = k} for k = 1..N (mpm_solid/README.md,
+Heterogeneous coal), plus the --set overrides. J runs go side by side with
+cores / J threads each, so jobs x threads never exceed the cores. Writes
+OUT/ensemble.csv (a row per seed), OUT/ensemble.md (the statistics) and
+OUT/ensemble.png (each quantity's runs, mean and interval). A finished run
+keeps its row in its folder (row.json); --resume reads it instead of running
+it again when the overrides are the same.
+"""
+import argparse
+import concurrent.futures
+import csv
+import json
+import math
+import os
+import sys
+
+import numpy as np
+from scipy import stats
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.dirname(HERE))
+sys.path.insert(0, HERE)
+from sensitivity import headline  # noqa: E402
+from study import run_one  # noqa: E402
+
+# The headline numbers the statistics cover, with their labels.
+QUANTITIES = [
+    ("centre_m_per_s", "centre tracer's peak speed [m/s]"),
+    ("farthest_m", "farthest coal from the face [m]"),
+    ("ejected_fraction", "coal ejected (share)"),
+    ("fully_damaged_fraction", "fully damaged coal (share)"),
+    ("gas_released_m3_per_m", "gas released [m3/m]"),
+]
+
+
+def one_seed(program, overrides, directory, threads, resume):
+    """Runs one member (or keeps its earlier row); returns its row."""
+    kept = os.path.join(directory, "row.json")
+    if resume and os.path.exists(kept):
+        with open(kept) as f:
+            earlier = json.load(f)
+        if earlier["overrides"] == overrides:
+            return earlier["row"]
+    wall, failure = run_one(program, os.path.join(HERE, "outburst.toml"), overrides, directory, threads)
+    row = {"wall_s": wall}
+    if failure:
+        row["failure"] = failure.split("] ")[-1]
+    else:
+        row.update(headline(directory))
+    with open(kept, "w") as f:
+        json.dump({"overrides": overrides, "row": row}, f)
+    return row
+
+
+def summary(values):
+    """Mean, sample standard deviation and the 95 % interval of the mean (Student t)."""
+    v = np.asarray(values, dtype=float)
+    mean = float(v.mean())
+    if len(v) < 2:
+        return mean, math.nan, math.nan
+    sd = float(v.std(ddof=1))
+    return mean, sd, float(stats.t.ppf(0.975, len(v) - 1) * sd / math.sqrt(len(v)))
+
+
+def plot(rows, path):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    ok = [r for r in rows if "failure" not in r]
+    fig, axes = plt.subplots(1, len(QUANTITIES), figsize=(3.2 * len(QUANTITIES), 3.4))
+    for ax, (key, label) in zip(axes, QUANTITIES):
+        values = [r[key] for r in ok]
+        mean, _, half = summary(values)
+        ax.plot(np.zeros(len(values)), values, "o", alpha=0.6, label="runs")
+        if math.isfinite(half):
+            ax.errorbar([0.3], [mean], yerr=[half], fmt="s", color="k", capsize=4, label="mean, 95 % CI")
+        ax.set_xlim(-0.5, 0.8)
+        ax.set_xticks([])
+        ax.set_title(label, fontsize=9)
+    axes[0].legend(fontsize=8)
+    fig.suptitle(f"outburst ensemble over heterogeneous coal: {len(ok)} seeds")
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--outburst", default="build/coupler/outburst")
+    ap.add_argument("--out", default="results/outburst_ensemble")
+    ap.add_argument("--seeds", type=int, default=8)
+    ap.add_argument("--homogeneity", type=float, default=3.0)
+    ap.add_argument("--end-time", default="1 s")
+    ap.add_argument("--jobs", type=int, default=0, help="runs side by side (0: one per core)")
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="another override for every run")
+    ap.add_argument("--resume", action="store_true", help="keep the rows an earlier ensemble finished")
+    args = ap.parse_args()
+    if args.seeds < 1:
+        ap.error("--seeds must be at least 1")
+    if args.homogeneity < 1:
+        ap.error("--homogeneity must be at least 1 (the Weibull shape of the strengths)")
+    cores = os.cpu_count() or 1
+    jobs = min(args.jobs or cores, cores, args.seeds)
+    if jobs < 1:
+        ap.error("--jobs must be at least 1")
+    threads = max(1, cores // jobs)
+    os.makedirs(args.out, exist_ok=True)
+    members = []
+    for seed in range(1, args.seeds + 1):
+        overrides = [f'scene.end_time="{args.end_time}"',
+                     f"mpm.materials[0].heterogeneity={{homogeneity_index={args.homogeneity:g}, seed={seed}}}"]
+        members.append((seed, overrides + args.set, os.path.join(args.out, f"seed_{seed:03d}")))
+    print(f"ensemble: {args.seeds} seeds, {jobs} side by side with {threads} thread(s) each", flush=True)
+    rows = {}
+    with concurrent.futures.ThreadPoolExecutor(max_workers=jobs) as pool:
+        futures = {pool.submit(one_seed, args.outburst, o, d, threads, args.resume): s for s, o, d in members}
+        for done in concurrent.futures.as_completed(futures):
+            seed = futures[done]
+            rows[seed] = {"seed": seed, **done.result()}
+            state = rows[seed].get("failure", "done")
+            print(f"seed {seed}: {state} ({rows[seed]['wall_s']:.0f} s)", flush=True)
+    rows = [rows[s] for s in sorted(rows)]
+    fields = []
+    for r in rows:
+        fields += [k for k in r if k not in fields]
+    with open(os.path.join(args.out, "ensemble.csv"), "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=fields)
+        w.writeheader()
+        w.writerows(rows)
+    ok = [r for r in rows if "failure" not in r]
+    lines = ["# Outburst ensemble over heterogeneous coal", "",
+             f"{len(ok)} of {len(rows)} seeds finished; homogeneity index {args.homogeneity:g}, "
+             f"{args.end_time} simulated; overrides: {', '.join(args.set) or 'none'}.", "",
+             "| quantity | mean | standard deviation | 95 % interval of the mean | min | max |",
+             "|---|---|---|---|---|---|"]
+    for key, label in QUANTITIES:
+        values = [r[key] for r in ok]
+        if not values:
+            continue
+        mean, sd, half = summary(values)
+        lines.append(f"| {label} | {mean:.4g} | {sd:.3g} | +- {half:.3g} | {min(values):.4g} | {max(values):.4g} |")
+    for r in rows:
+        if "failure" in r:
+            lines.append(f"\nseed {r['seed']} failed: {r['failure']}")
+    with open(os.path.join(args.out, "ensemble.md"), "w") as f:
+        f.write("\n".join(lines) + "\n")
+    if ok:
+        plot(rows, os.path.join(args.out, "ensemble.png"))
+    print("\n".join(lines))
+    if not ok:
+        sys.exit("ensemble: no seed finished")
+
+
+if __name__ == "__main__":
+    main()
