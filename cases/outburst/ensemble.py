@@ -5,16 +5,19 @@ the Weibull draw, side by side, and each headline number's mean, spread and
 
 usage: ensemble.py [--outburst build/coupler/outburst] [--out results/outburst_ensemble]
                    [--seeds 8] [--homogeneity 3] [--end-time "1 s"] [--jobs J]
-                   [--set KEY=VALUE ...] [--resume]
+                   [--set KEY=VALUE ...] [--sweep KEY --values V1 V2 ...] [--resume]
 
 Each run is the shipped case with mpm.materials[0].heterogeneity = {
 homogeneity_index = M, seed = k} for k = 1..N (mpm_solid/README.md,
 Heterogeneous coal), plus the --set overrides. J runs go side by side with
 cores / J threads each, so jobs x threads never exceed the cores. Writes
 OUT/ensemble.csv (a row per seed), OUT/ensemble.md (the statistics) and
-OUT/ensemble.png (each quantity's runs, mean and interval). A finished run
-keeps its row in its folder (row.json); --resume reads it instead of running
-it again when the overrides are the same.
+OUT/ensemble.png (each quantity's runs, mean and interval). With --sweep, one
+ensemble runs at each value of KEY (OUT/value_NN_VALUE/), and OUT/sweep.md and
+OUT/sweep.png set each quantity's mean and interval against the values: a
+knob's effect beside the spread the coal alone gives. A finished run keeps its
+row in its folder (row.json); --resume reads it instead of running it again
+when the overrides are the same.
 """
 import argparse
 import concurrent.futures
@@ -22,6 +25,7 @@ import csv
 import json
 import math
 import os
+import re
 import sys
 
 import numpy as np
@@ -93,33 +97,14 @@ def plot(rows, path):
     fig.savefig(path, dpi=120)
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--outburst", default="build/coupler/outburst")
-    ap.add_argument("--out", default="results/outburst_ensemble")
-    ap.add_argument("--seeds", type=int, default=8)
-    ap.add_argument("--homogeneity", type=float, default=3.0)
-    ap.add_argument("--end-time", default="1 s")
-    ap.add_argument("--jobs", type=int, default=0, help="runs side by side (0: one per core)")
-    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="another override for every run")
-    ap.add_argument("--resume", action="store_true", help="keep the rows an earlier ensemble finished")
-    args = ap.parse_args()
-    if args.seeds < 1:
-        ap.error("--seeds must be at least 1")
-    if args.homogeneity < 1:
-        ap.error("--homogeneity must be at least 1 (the Weibull shape of the strengths)")
-    cores = os.cpu_count() or 1
-    jobs = min(args.jobs or cores, cores, args.seeds)
-    if jobs < 1:
-        ap.error("--jobs must be at least 1")
-    threads = max(1, cores // jobs)
-    os.makedirs(args.out, exist_ok=True)
+def run_ensemble(args, overrides, out, jobs, threads):
+    """Runs (or resumes) one ensemble into out, writes its CSV, table and plot; returns its rows."""
+    os.makedirs(out, exist_ok=True)
     members = []
     for seed in range(1, args.seeds + 1):
-        overrides = [f'scene.end_time="{args.end_time}"',
-                     f"mpm.materials[0].heterogeneity={{homogeneity_index={args.homogeneity:g}, seed={seed}}}"]
-        members.append((seed, overrides + args.set, os.path.join(args.out, f"seed_{seed:03d}")))
-    print(f"ensemble: {args.seeds} seeds, {jobs} side by side with {threads} thread(s) each", flush=True)
+        member = [f'scene.end_time="{args.end_time}"',
+                  f"mpm.materials[0].heterogeneity={{homogeneity_index={args.homogeneity:g}, seed={seed}}}"]
+        members.append((seed, member + overrides, os.path.join(out, f"seed_{seed:03d}")))
     rows = {}
     with concurrent.futures.ThreadPoolExecutor(max_workers=jobs) as pool:
         futures = {pool.submit(one_seed, args.outburst, o, d, threads, args.resume): s for s, o, d in members}
@@ -127,19 +112,19 @@ def main():
             seed = futures[done]
             rows[seed] = {"seed": seed, **done.result()}
             state = rows[seed].get("failure", "done")
-            print(f"seed {seed}: {state} ({rows[seed]['wall_s']:.0f} s)", flush=True)
+            print(f"{out}: seed {seed}: {state} ({rows[seed]['wall_s']:.0f} s)", flush=True)
     rows = [rows[s] for s in sorted(rows)]
     fields = []
     for r in rows:
         fields += [k for k in r if k not in fields]
-    with open(os.path.join(args.out, "ensemble.csv"), "w", newline="") as f:
+    with open(os.path.join(out, "ensemble.csv"), "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=fields)
         w.writeheader()
         w.writerows(rows)
     ok = [r for r in rows if "failure" not in r]
     lines = ["# Outburst ensemble over heterogeneous coal", "",
              f"{len(ok)} of {len(rows)} seeds finished; homogeneity index {args.homogeneity:g}, "
-             f"{args.end_time} simulated; overrides: {', '.join(args.set) or 'none'}.", "",
+             f"{args.end_time} simulated; overrides: {', '.join(overrides) or 'none'}.", "",
              "| quantity | mean | standard deviation | 95 % interval of the mean | min | max |",
              "|---|---|---|---|---|---|"]
     for key, label in QUANTITIES:
@@ -151,13 +136,78 @@ def main():
     for r in rows:
         if "failure" in r:
             lines.append(f"\nseed {r['seed']} failed: {r['failure']}")
-    with open(os.path.join(args.out, "ensemble.md"), "w") as f:
+    with open(os.path.join(out, "ensemble.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
     if ok:
-        plot(rows, os.path.join(args.out, "ensemble.png"))
+        plot(rows, os.path.join(out, "ensemble.png"))
+    print("\n".join(lines), flush=True)
+    return rows
+
+
+def sweep_report(key, values, ensembles, out):
+    """Each quantity's mean and interval at each value of the swept key: sweep.md and sweep.png."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    lines = [f"# Outburst ensembles against {key}", "",
+             "| quantity | " + " | ".join(f"{key} = {v}" for v in values) + " |",
+             "|---|" + "---|" * len(values)]
+    fig, axes = plt.subplots(1, len(QUANTITIES), figsize=(3.2 * len(QUANTITIES), 3.4))
+    for ax, (q, label) in zip(axes, QUANTITIES):
+        cells, means, halves = [], [], []
+        for rows in ensembles:
+            finished = [r[q] for r in rows if "failure" not in r]
+            mean, _, half = summary(finished) if finished else (math.nan, math.nan, math.nan)
+            cells.append(f"{mean:.4g} +- {half:.2g} ({len(finished)} seeds)")
+            means.append(mean)
+            halves.append(half if math.isfinite(half) else 0.0)
+        lines.append(f"| {label} | " + " | ".join(cells) + " |")
+        ax.errorbar(range(len(values)), means, yerr=halves, fmt="o-", capsize=4)
+        ax.set_xticks(range(len(values)), values, rotation=30, fontsize=8)
+        ax.set_title(label, fontsize=9)
+    fig.suptitle(f"outburst ensembles against {key} (mean, 95 % interval of the mean)")
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "sweep.png"), dpi=120)
+    with open(os.path.join(out, "sweep.md"), "w") as f:
+        f.write("\n".join(lines) + "\n")
     print("\n".join(lines))
-    if not ok:
-        sys.exit("ensemble: no seed finished")
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--outburst", default="build/coupler/outburst")
+    ap.add_argument("--out", default="results/outburst_ensemble")
+    ap.add_argument("--seeds", type=int, default=8)
+    ap.add_argument("--homogeneity", type=float, default=3.0)
+    ap.add_argument("--end-time", default="1 s")
+    ap.add_argument("--jobs", type=int, default=0, help="runs side by side (0: one per core)")
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="another override for every run")
+    ap.add_argument("--sweep", metavar="KEY", help="a scene key to run an ensemble at each of --values")
+    ap.add_argument("--values", nargs="+", default=[], metavar="VALUE", help="the swept key's values (TOML)")
+    ap.add_argument("--resume", action="store_true", help="keep the rows an earlier ensemble finished")
+    args = ap.parse_args()
+    if args.seeds < 1:
+        ap.error("--seeds must be at least 1")
+    if args.homogeneity < 1:
+        ap.error("--homogeneity must be at least 1 (the Weibull shape of the strengths)")
+    if bool(args.sweep) != bool(args.values):
+        ap.error("--sweep KEY and --values go together")
+    cores = os.cpu_count() or 1
+    jobs = min(args.jobs or cores, cores, args.seeds)
+    if jobs < 1:
+        ap.error("--jobs must be at least 1")
+    threads = max(1, cores // jobs)
+    print(f"ensemble: {args.seeds} seeds, {jobs} side by side with {threads} thread(s) each", flush=True)
+    if not args.sweep:
+        rows = run_ensemble(args, args.set, args.out, jobs, threads)
+        if not any("failure" not in r for r in rows):
+            sys.exit("ensemble: no seed finished")
+        return
+    # Folder names without the brackets and quotes of keys and values (glob reads brackets).
+    ensembles = [run_ensemble(args, args.set + [f"{args.sweep}={v}"],
+                              os.path.join(args.out, f"value_{k:02d}_" + re.sub(r"[^\w.+-]+", "_", v)), jobs, threads)
+                 for k, v in enumerate(args.values)]
+    sweep_report(args.sweep, args.values, ensembles, args.out)
 
 
 if __name__ == "__main__":
