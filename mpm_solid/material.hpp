@@ -91,7 +91,8 @@ struct MaterialModel {
   std::unique_ptr<Material> (*read)(const scene::Table& table, const MaterialContext& context);
 };
 
-// The models registered, in a fixed order (by name).
+// The models registered, in a fixed order (by name). The list is taken at the
+// first call: not to be called during static initialisation.
 const std::vector<MaterialModel>& material_models();
 // Adds a model; each model's file calls it once, at static initialisation:
 // `[[maybe_unused]] const bool registered = register_material({...});`.

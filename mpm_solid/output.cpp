@@ -9,9 +9,9 @@
 namespace outburst::mpm {
 
 namespace {
-// The time step's own energy error above which a run is warned. The shipped
-// scenes stay under 7 % at Courant 0.3 (the elastic block, B-splines, USF);
-// the error falls at first order with the step (tests/CMakeLists.txt).
+// The time step's own energy error above which a run is warned: the shipped
+// scenes stay under it at Courant 0.3, and the error falls at first order
+// with the step (tests/CMakeLists.txt).
 constexpr double integration_warning = 0.1;
 }  // namespace
 

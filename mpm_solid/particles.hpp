@@ -8,6 +8,8 @@
 #include <type_traits>
 #include <vector>
 
+#include <fmt/format.h>
+
 #include "common/checkpoint.hpp"
 #include "mpm_solid/grid.hpp"
 
@@ -56,6 +58,7 @@ struct Particles {
     std::vector<T> Particles::*values;
     const char* effect = nullptr;              // null: every scene carries it
     std::vector<T> Particles::*starts_as = nullptr;
+    double fill = 0;                           // a created scalar field's value, without starts_as
     bool optional() const { return effect != nullptr; }
   };
   static constexpr auto fields() {
@@ -75,7 +78,7 @@ struct Particles {
         Field<double>{"damage", &P::damage, "damage"},
         Field<Mat<Dim>>{"effective_stress", &P::effective_stress, "damage", &P::stress},
         Field<double>{"effective_stress_zz", &P::effective_stress_zz, "damage", &P::stress_zz},
-        Field<double>{"strength_scale", &P::strength_scale, "heterogeneity"});
+        Field<double>{"strength_scale", &P::strength_scale, "heterogeneity", nullptr, 1.0});
   }
   template <class F>
   void for_each_field(F&& f) {
@@ -94,9 +97,7 @@ struct Particles {
       if (field.starts_as)
         values = this->*field.starts_as;
       else
-        values.assign(size(), {});
-      if constexpr (requires { values[0].setZero(); })
-        if (!field.starts_as) for (auto& v : values) v.setZero();
+        values.assign(size(), initial(field));
     });
   }
   void need_loads() { need("loads"); }
@@ -118,14 +119,26 @@ struct Particles {
   }
   void load(const checkpoint::In& in) {
     const auto optional = in.group("optional");
-    const std::size_t n = in.matrices<Dim, 1>("x").size();
+    x = in.matrices<Dim, 1>("x");
+    const std::size_t n = x.size();
     for_each_field([&](const auto& field, auto& values) {
+      if (static_cast<const void*>(&values) == static_cast<const void*>(&x)) return;
       if (!field.optional())
         read(in, field.name, n, values);
       else if (optional.has(field.name))
         read(optional, field.name, n, values);
       else
         values.clear();
+    });
+    // An effect's fields come and go together (the kernels test one of them).
+    for_each_field([&](const auto& field, const auto& values) {
+      if (!field.optional()) return;
+      for_each_field([&](const auto& other, const auto& others) {
+        if (other.optional() && std::string_view(other.effect) == field.effect && others.empty() != values.empty())
+          optional.fail(field.name, fmt::format("\"{}\" without \"{}\" of the same effect ({})",
+                                                values.empty() ? other.name : field.name,
+                                                values.empty() ? field.name : other.name, field.effect));
+      });
     });
   }
 
@@ -151,10 +164,8 @@ struct Particles {
       if (!field.optional() || values.empty()) return;
       if (field.starts_as)
         values.push_back((this->*field.starts_as).back());
-      else if constexpr (requires { values[0].setZero(); })
-        values.push_back(std::decay_t<decltype(values[0])>::Zero());
       else
-        values.push_back({});
+        values.push_back(initial(field));
     });
   }
 
@@ -171,6 +182,13 @@ struct Particles {
   }
 
  private:
+  template <class T>
+  static T initial(const Field<T>& field) {
+    if constexpr (std::is_arithmetic_v<T>)
+      return static_cast<T>(field.fill);
+    else
+      return T::Zero();
+  }
   template <class T>
   static void write(checkpoint::Out out, const char* name, const std::vector<T>& values) {
     if constexpr (std::is_same_v<T, double>)

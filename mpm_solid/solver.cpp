@@ -378,7 +378,9 @@ void Solver::grid_update(double dt) {
         if (velocity_[i][d] != 0) {
           const double damping = alpha * std::abs(force_[i][d]);
           force_[i][d] -= damping * std::copysign(1.0, velocity_[i][d]);
-          work += damping * std::abs(velocity_[i][d]) * dt;
+          // Ghosts beyond a fixed or roller wall mirror a node inside: their
+          // work is that node's, booked once.
+          if (counted_[i]) work += damping * std::abs(velocity_[i][d]) * dt;
         }
     dissipated_.damping += work;
   }
@@ -391,9 +393,9 @@ void Solver::grid_update(double dt) {
   apply_platens(velocity_new_, shrink * dt, dt);  // before the walls: the ghost nodes mirror the plate's motion
   dissipated_.walls += apply_walls(velocity_new_);
   // The grid's work on pure FLIP particles is sum_i p_i . dv_i here, with
-  // the momenta p_i they mapped, plus sum_p m_p |dv_p|^2 / 2 in gather_motion
-  // (Solver::energies). Walls and platens changed p_i to m_i v_i before the
-  // update: that change, worked by the update, is theirs.
+  // the momenta p_i they mapped, plus sum_p m_p sum_i w_ip |dv_i|^2 / 2 in
+  // gather_motion (Solver::energies). Walls and platens changed p_i to
+  // m_i v_i before the update: that change, worked by the update, is theirs.
   double work = 0, projected = 0;
 #pragma omp parallel for schedule(static) reduction(+ : work, projected)
   for (std::size_t i = 0; i < n; ++i)

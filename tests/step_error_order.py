@@ -16,11 +16,14 @@ import sys
 
 
 def largest_step_error(directory):
+    """The largest |integration|, the end time and the median step of a run."""
     with open(os.path.join(directory, "mpm_history.csv")) as f:
         rows = list(csv.DictReader(f))
     if not rows:
         sys.exit(f"{directory}: no rows")
-    return max(abs(float(r["integration_J_per_m"])) for r in rows), float(rows[-1]["time_s"])
+    steps = sorted(float(r["dt_s"]) for r in rows)
+    return (max(abs(float(r["integration_J_per_m"])) for r in rows), float(rows[-1]["time_s"]),
+            steps[len(steps) // 2])
 
 
 def main():
@@ -30,11 +33,14 @@ def main():
     ap.add_argument("--order", type=float, default=1.0)
     ap.add_argument("--slack", type=float, default=0.2)
     args = ap.parse_args()
-    (coarse, t_coarse), (fine, t_fine) = largest_step_error(args.coarse), largest_step_error(args.fine)
+    (coarse, t_coarse, dt_coarse), (fine, t_fine, dt_fine) = largest_step_error(args.coarse), largest_step_error(args.fine)
     if not math.isclose(t_coarse, t_fine, rel_tol=1e-6):
         sys.exit(f"the runs end at different times: {t_coarse:g} s and {t_fine:g} s")
-    if fine <= 0:
-        sys.exit(f"{args.fine}: no time step error at all: the books cannot be measuring it")
+    if not math.isclose(dt_coarse / dt_fine, 2, rel_tol=0.1):
+        sys.exit(f"the fine run's step is not half the coarse one's: median steps {dt_coarse:.4g} s and "
+                 f"{dt_fine:.4g} s")
+    if fine <= 0 or coarse <= 0:
+        sys.exit("a run shows no time step error at all: the books cannot be measuring it")
     order = math.log2(coarse / fine)
     print(f"largest time step error {coarse:.4g} J/m, with half the step {fine:.4g} J/m: order {order:.2f} "
           f"(expected {args.order:g} +- {args.slack:g})")

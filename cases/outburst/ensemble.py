@@ -53,7 +53,8 @@ def one_seed(program, overrides, directory, threads, resume):
     if resume and os.path.exists(kept):
         with open(kept) as f:
             earlier = json.load(f)
-        if earlier["overrides"] == overrides:
+        # Only a finished run is kept: one that failed (or was killed) runs again.
+        if earlier["overrides"] == overrides and "failure" not in earlier["row"]:
             return earlier["row"]
     wall, failure = run_one(program, os.path.join(HERE, "outburst.toml"), overrides, directory, threads)
     row = {"wall_s": wall}
@@ -150,6 +151,8 @@ def sweep_report(key, values, ensembles, out):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     lines = [f"# Outburst ensembles against {key}", "",
+             "Mean +- the 95 % interval of the mean. The same seeds run at every value, so the coals are "
+             "paired (unless the key changes how particles are created).", "",
              "| quantity | " + " | ".join(f"{key} = {v}" for v in values) + " |",
              "|---|" + "---|" * len(values)]
     fig, axes = plt.subplots(1, len(QUANTITIES), figsize=(3.2 * len(QUANTITIES), 3.4))
@@ -160,9 +163,15 @@ def sweep_report(key, values, ensembles, out):
             mean, _, half = summary(finished) if finished else (math.nan, math.nan, math.nan)
             cells.append(f"{mean:.4g} +- {half:.2g} ({len(finished)} seeds)")
             means.append(mean)
-            halves.append(half if math.isfinite(half) else 0.0)
+            halves.append(half)
         lines.append(f"| {label} | " + " | ".join(cells) + " |")
-        ax.errorbar(range(len(values)), means, yerr=halves, fmt="o-", capsize=4)
+        # A value with fewer than two finished seeds has no interval: drawn hollow, no bar.
+        has = [math.isfinite(h) for h in halves]
+        ax.errorbar([k for k in range(len(values)) if has[k]], [m for m, h in zip(means, has) if h],
+                    yerr=[x for x in halves if math.isfinite(x)], fmt="o", capsize=4)
+        ax.plot(range(len(values)), means, "-", color="C0")
+        ax.plot([k for k in range(len(values)) if not has[k]], [m for m, h in zip(means, has) if not h], "o",
+                mfc="none", color="C0")
         ax.set_xticks(range(len(values)), values, rotation=30, fontsize=8)
         ax.set_title(label, fontsize=9)
     fig.suptitle(f"outburst ensembles against {key} (mean, 95 % interval of the mean)")

@@ -89,10 +89,7 @@ void ElasticDamage::create_fields(Particles<2>& p, const std::vector<int>& membe
   p.need_plastic_strain();
   p.need_damage();
   if (!parameters_.heterogeneity) return;
-  if (p.strength_scale.empty()) {
-    p.need("heterogeneity");
-    std::fill(p.strength_scale.begin(), p.strength_scale.end(), 1.0);
-  }
+  p.need("heterogeneity");
   for (const int i : members) p.strength_scale[i] = weibull_strength_scale(*parameters_.heterogeneity, p.id[i]);
 }
 
