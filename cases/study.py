@@ -220,6 +220,17 @@ def program_path(program, build, study_dir):
 REFUSED = 4
 
 
+def write_rows(path, rows):
+    """Rows of dicts to a CSV whose columns are every key, in the order first met."""
+    fields = []
+    for r in rows:
+        fields += [k for k in r if k not in fields]
+    with open(path, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=fields)
+        w.writeheader()
+        w.writerows(rows)
+
+
 def run_one(program, scene, overrides, directory, threads):
     """Runs a program on a scene with overrides; its wall time and, if it failed, its last message."""
     # Studies rerun into their folders: the earlier run's files are replaced.
@@ -392,13 +403,7 @@ def main():
     front = set(pareto(rows))
     for i, r in enumerate(rows):
         r["pareto"] = i in front
-    fields = []
-    for r in rows:
-        fields += [k for k in r if k not in fields]
-    with open(os.path.join(out, "study.csv"), "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=fields)
-        w.writeheader()
-        w.writerows(rows)
+    write_rows(os.path.join(out, "study.csv"), rows)
 
     # Each numeric knob's order: alone, or (combined) for each setting of the others.
     orders = []

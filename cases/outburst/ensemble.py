@@ -21,7 +21,6 @@ when the overrides are the same.
 """
 import argparse
 import concurrent.futures
-import csv
 import json
 import math
 import os
@@ -35,7 +34,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.dirname(HERE))
 sys.path.insert(0, HERE)
 from sensitivity import headline  # noqa: E402
-from study import run_one  # noqa: E402
+from study import run_one, write_rows  # noqa: E402
 
 # The headline numbers the statistics cover, with their labels.
 QUANTITIES = [
@@ -115,13 +114,7 @@ def run_ensemble(args, overrides, out, jobs, threads):
             state = rows[seed].get("failure", "done")
             print(f"{out}: seed {seed}: {state} ({rows[seed]['wall_s']:.0f} s)", flush=True)
     rows = [rows[s] for s in sorted(rows)]
-    fields = []
-    for r in rows:
-        fields += [k for k in r if k not in fields]
-    with open(os.path.join(out, "ensemble.csv"), "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=fields)
-        w.writeheader()
-        w.writerows(rows)
+    write_rows(os.path.join(out, "ensemble.csv"), rows)
     ok = [r for r in rows if "failure" not in r]
     lines = ["# Outburst ensemble over heterogeneous coal", "",
              f"{len(ok)} of {len(rows)} seeds finished; homogeneity index {args.homogeneity:g}, "

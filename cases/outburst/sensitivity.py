@@ -13,7 +13,6 @@ resolution, 40 minutes). Each finished row is kept in its run folder
 same overrides and end time instead of running them again.
 """
 import argparse
-import csv
 import json
 import os
 import subprocess
@@ -23,7 +22,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.dirname(HERE))
 sys.path.insert(0, HERE)
 from report import MPA, Run, axis_row, steepest_drop  # noqa: E402
-from study import run_one  # noqa: E402
+from study import run_one, write_rows  # noqa: E402
 
 FACE = 25.0
 TUNNEL_AXIS = 4.5  # between the floor (3 m) and the roof (6 m)
@@ -127,13 +126,7 @@ def main():
         rows.append(row)
         with open(kept, "w") as f:
             json.dump({"overrides": overrides, "row": row}, f)
-    fields = []
-    for r in rows:
-        fields += [k for k in r if k not in fields]
-    with open(os.path.join(args.out, "sensitivity.csv"), "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=fields)
-        w.writeheader()
-        w.writerows(rows)
+    write_rows(os.path.join(args.out, "sensitivity.csv"), rows)
     lines = ["# Outburst: sensitivity of the headline numbers", "",
              f"Each row changes one choice of `cases/outburst/outburst.toml`; {args.end_time} simulated.", "",
              "| variant | centre / top / bottom peak speed [m/s] | farthest [m] | ejected | fully damaged "
