@@ -51,7 +51,10 @@ void fill_cells(const Grid<2>& grid, int per_cell, const Vec<2>& lo, const Vec<2
     for (int i = i0; i < i1; ++i)
       for (int b = 0; b < per_cell; ++b)
         for (int a = 0; a < per_cell; ++a) {
-          const Vec<2> x = grid.lower + Vec<2>(i * h + (a + 0.5) * step, j * h + (b + 0.5) * step);
+          // One rounding order, written out: left to the compiler's choice of
+          // contraction into FMA, the seeds moved by an ulp whenever inlining
+          // around this loop changed, and the chaotic outburst with them.
+          const Vec<2> x = grid.lower + Vec<2>(std::fma(i, h, (a + 0.5) * step), std::fma(j, h, (b + 0.5) * step));
           if ((x.array() >= lo.array()).all() && (x.array() <= hi.array()).all() && inside(x))
             points.push_back(x);
         }
