@@ -100,7 +100,10 @@ void require_solvers(const scene::Table& root, const SceneHeader& header,
 
 bool finish_reading(const RunOptions& options, const scene::Document& doc) {
   doc.reject_unused();
-  if (options.explain) std::fputs(doc.explain().c_str(), stdout);
+  if (options.explain) {
+    std::fputs((options.explain_format == "json" ? doc.explain_json() : doc.explain()).c_str(), stdout);
+    return false;
+  }
   if (options.check_only) {
     spdlog::info("{}: the scene is valid", doc.file().string());
     return false;
@@ -146,8 +149,13 @@ int run_program(const std::string& program, const std::string& description, int 
                "Continue the run in the output folder from its last checkpoint: give the scene, -o and --set of "
                "the stopped run (and the same -j for a bit-identical result)")
       ->excludes(overwrite);
-  app.add_flag("--explain", options.explain,
-               "Print every key the scene uses with its value, default and meaning");
+  auto* explain = app.add_flag("--explain", options.explain,
+                               "Print every key the scene uses with its value, default and meaning, and stop");
+  app.add_option("--format", options.explain_format,
+                 "What --explain prints: text, or json (each key also with what it expects, the words a choice "
+                 "takes and its range)")
+      ->check(CLI::IsMember({"text", "json"}))
+      ->needs(explain);
   app.add_flag("-q,--quiet", options.quiet, "No progress line");
   app.add_option("--log-level", options.log_level, "trace, debug, info, warn, error")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));

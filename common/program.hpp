@@ -2,7 +2,7 @@
 // The command line shared by every program of the project:
 //
 //   <program> SCENE [--output DIR] [--overwrite | --restart] [--set key=value]...
-//             [--check] [--explain] [--quiet] [--log-level LEVEL] [--threads N]
+//             [--check] [--explain [--format text|json]] [--quiet] [--log-level LEVEL] [--threads N]
 //
 // Checkpoints (common/checkpoint.hpp): every program writes its complete state
 // to DIR/checkpoint.h5 every [output] checkpoint_interval of simulated time
@@ -41,7 +41,8 @@ struct RunOptions {
   bool check_only = false;   // read and validate the scene, run nothing
   bool overwrite = false;    // replace an earlier run's files in the output folder
   bool restart = false;      // continue the output folder's run from its checkpoint
-  bool explain = false;      // print every key the scene uses, with defaults
+  bool explain = false;      // print every key the scene uses, with defaults, and stop
+  std::string explain_format = "text";  // or "json"
   bool quiet = false;        // no progress line
   std::string log_level = "info";
   int threads = 0;           // 0: OpenMP's default
@@ -155,7 +156,7 @@ output::RunInfo run_info(const std::string& program, const scene::Document& doc,
                          const std::string& units);
 
 // After reading: reject unknown keys and honour --explain / --check.
-// Returns false when the program should stop here (check only).
+// Returns false when the program should stop here (--check, --explain).
 bool finish_reading(const RunOptions& options, const scene::Document& doc);
 
 }  // namespace outburst

@@ -338,6 +338,26 @@ std::string Document::explain() const {
   return out;
 }
 
+std::string Document::explain_json() const {
+  toml::array keys;
+  for (const auto& r : records_) {
+    toml::array choices;
+    for (const auto& c : r.choices) choices.push_back(c);
+    keys.push_back(toml::table{{"key", r.path},
+                               {"value", r.value},
+                               {"default", r.defaulted},
+                               {"fallback", r.fallback},
+                               {"doc", r.doc},
+                               {"expects", r.expects},
+                               {"choices", std::move(choices)},
+                               {"range", r.range}});
+  }
+  const toml::table root{{"scene", file_.string()}, {"keys", std::move(keys)}};
+  std::ostringstream out;
+  out << toml::json_formatter{root} << "\n";
+  return out.str();
+}
+
 // ---------------------------------------------------------------- Table
 
 Table::Table(Document* doc, const toml::table* table, std::string path)
@@ -372,8 +392,15 @@ const toml::node* Table::required_node(const Key& key) const {
   return n;
 }
 
-void Table::record(const Key& key, const std::string& value, bool defaulted) const {
-  doc_->records_.push_back({key_path(key.name), value, defaulted, std::string(key.doc)});
+void Table::record(const Key& key, const std::string& value, bool defaulted, std::string expects,
+                   std::vector<std::string> choices, std::string range) const {
+  // A key without limits shows none (not its type's, not "finite").
+  if (!key.range.min && !key.range.max)
+    range.clear();
+  else if (range.empty())
+    range = key.range.describe();
+  doc_->records_.push_back({key_path(key.name), value, defaulted, std::string(key.doc), std::string(key.fallback),
+                            std::move(expects), std::move(choices), std::move(range)});
 }
 
 namespace {
@@ -435,7 +462,7 @@ std::pair<double, units::Dimension> Table::quantity_of(const Key& key,
   }
   if (!key.range.contains(q.si))
     fail(key.name, fmt::format("must be {}, got \"{}\"", range_text(key.range, q.dimension), text));
-  record(key, text, n == nullptr);
+  record(key, text, n == nullptr, expected, {}, range_text(key.range, q.dimension));
   return {q.si, q.dimension};
 }
 
@@ -466,7 +493,8 @@ std::vector<double> Table::quantity_vector(const Key& key, const units::Dimensio
     values.push_back(q.si);
     shown += fmt::format("{}\"{}\"", shown.empty() ? "" : ", ", t);
   }
-  record(key, "[" + shown + "]", n == nullptr);
+  record(key, "[" + shown + "]", n == nullptr, fmt::format("{} values: {}", count, units::describe(dimension)), {},
+         range_text(key.range, dimension));
   return values;
 }
 
@@ -487,7 +515,7 @@ std::vector<std::array<double, 2>> Table::quantity_points(const Key& key,
     points.push_back({quantity_from_text(pair->get(0)->as_string()->get(), dimension, fail_here).si,
                       quantity_from_text(pair->get(1)->as_string()->get(), dimension, fail_here).si});
   }
-  record(key, node_text(*n), false);
+  record(key, node_text(*n), false, "[time, value] pairs: " + units::describe(dimension));
   return points;
 }
 
@@ -506,7 +534,7 @@ double Table::number(const Key& key) const {
   }
   if (!key.range.contains(v))
     fail(key.name, fmt::format("must be {}, got {:g}", key.range.describe(), v));
-  record(key, n ? node_text(*n) : std::string(key.fallback), n == nullptr);
+  record(key, n ? node_text(*n) : std::string(key.fallback), n == nullptr, "a number");
   return v;
 }
 
@@ -522,7 +550,7 @@ T Table::integer(const Key& key) const {
   }
   const Range range = within_type<T>(key.range);
   if (!range.contains(static_cast<double>(v))) fail(key.name, fmt::format("must be {}, got {}", range.describe(), v));
-  record(key, std::to_string(v), n == nullptr);
+  record(key, std::to_string(v), n == nullptr, "an integer", {}, within_type<T>(key.range).describe());
   return static_cast<T>(v);
 }
 
@@ -549,7 +577,7 @@ std::vector<T> Table::integer_vector(const Key& key, std::size_t count) const {
       fail(key.name, fmt::format("each entry must be {}, got {}", range.describe(), v));
     shown += fmt::format("{}{}", shown.empty() ? "" : ", ", v);
   }
-  record(key, "[" + shown + "]", n == nullptr);
+  record(key, "[" + shown + "]", n == nullptr, fmt::format("{} integers", count), {}, range.describe());
   return {values.begin(), values.end()};
 }
 
@@ -579,7 +607,7 @@ std::vector<double> Table::number_vector(const Key& key, std::size_t count) cons
       fail(key.name, fmt::format("each entry must be {}, got {:g}", key.range.describe(), v));
     shown += fmt::format("{}{:g}", shown.empty() ? "" : ", ", v);
   }
-  record(key, "[" + shown + "]", n == nullptr);
+  record(key, "[" + shown + "]", n == nullptr, fmt::format("{} numbers", count));
   return values;
 }
 
@@ -590,7 +618,7 @@ bool Table::boolean(const Key& key) const {
     if (!n->is_boolean()) fail(key.name, fmt::format("expected true or false, got {}", node_text(*n)));
     v = n->as_boolean()->get();
   }
-  record(key, v ? "true" : "false", n == nullptr);
+  record(key, v ? "true" : "false", n == nullptr, "true or false");
   return v;
 }
 
@@ -601,7 +629,7 @@ std::string Table::string(const Key& key) const {
     if (!n->is_string()) fail(key.name, fmt::format("expected a string, got {}", node_text(*n)));
     v = n->as_string()->get();
   }
-  record(key, "\"" + v + "\"", n == nullptr);
+  record(key, "\"" + v + "\"", n == nullptr, "a string");
   return v;
 }
 
@@ -615,7 +643,7 @@ std::string Table::choice(const Key& key, const std::vector<std::string_view>& c
   }
   if (std::find(choices.begin(), choices.end(), v) == choices.end())
     fail(key.name, fmt::format("expected one of {}, got \"{}\"", join(choices), v));
-  record(key, "\"" + v + "\"", n == nullptr);
+  record(key, "\"" + v + "\"", n == nullptr, "one of", {choices.begin(), choices.end()});
   return v;
 }
 
@@ -643,7 +671,7 @@ std::vector<std::string> Table::choice_list(const Key& key,
       fail(key.name, fmt::format("\"{}\" is listed twice", v));
     shown += fmt::format("{}\"{}\"", shown.empty() ? "" : ", ", v);
   }
-  record(key, "[" + shown + "]", n == nullptr);
+  record(key, "[" + shown + "]", n == nullptr, "a list of", {choices.begin(), choices.end()});
   return values;
 }
 
@@ -684,7 +712,8 @@ TimeFunction Table::time_function(const Key& key, const units::Dimension& dimens
                                  pair->get(1)->as_string()->get()));
     points.emplace_back(t, v);
   }
-  record(key, node_text(*n), false);
+  record(key, node_text(*n), false, "a constant or [time, value] pairs: " + units::describe(dimension), {},
+         range_text(key.range, dimension));
   return TimeFunction(std::move(points));
 }
 

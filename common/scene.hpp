@@ -78,9 +78,13 @@ struct Key {
 // What `--explain` prints for each key the run read.
 struct ReadRecord {
   std::string path;
-  std::string value;
+  std::string value;  // as TOML would write it
   bool defaulted;
   std::string doc;
+  std::string fallback;              // the default as a scene would write it; empty: required
+  std::string expects;               // what the key takes ("a pressure", "a number", "one of")
+  std::vector<std::string> choices;  // the words a choice takes
+  std::string range;                 // the checked range, if any
 };
 
 class Document;
@@ -147,7 +151,10 @@ class Table {
  private:
   const toml::node* node(std::string_view key) const;
   const toml::node* required_node(const Key& key) const;
-  void record(const Key& key, const std::string& value, bool defaulted) const;
+  // `expects` and `choices` for --explain; `range` when the key's range is
+  // not shown in SI (angles).
+  void record(const Key& key, const std::string& value, bool defaulted, std::string expects,
+              std::vector<std::string> choices = {}, std::string range = {}) const;
   std::string key_path(std::string_view key) const;
 
   Document* doc_;
@@ -174,7 +181,12 @@ class Document {
   // Throws Error for the first key that no getter read, listing its siblings.
   void reject_unused() const;
   const std::vector<ReadRecord>& records() const { return records_; }
+  // Every key the run read: as aligned text lines, or as one JSON object
+  // {"scene": file, "keys": [{"key", "value", "default", "fallback", "doc",
+  // "expects", "choices", "range"}, ...]} for scripts that need the names a
+  // choice takes (tests, studies).
   std::string explain() const;
+  std::string explain_json() const;
 
   // Error message with location: "file:line:col: key 'a.b': message".
   std::string located(const toml::node* node, const std::string& key_path,

@@ -155,3 +155,20 @@ TEST_CASE("explain lists every key read, marking defaults", "[scene]") {
   CHECK_THAT(text, Catch::Contains("(default)"));
   CHECK_THAT(text, Catch::Contains("seepage.regions[0].lambda = 0.1 m2/(MPa2 d)"));
 }
+
+TEST_CASE("explain as JSON gives each key with what it expects, its choices and its range", "[scene]") {
+  auto doc = scene::Document::parse(valid, "valid.toml");
+  auto root = doc->root();
+  read_scene_header(root);
+  seepage::read_setup(*root.table("seepage", "", true));
+  const std::string json = doc->explain_json();
+  CHECK_THAT(json, Catch::StartsWith("{"));
+  CHECK_THAT(json, Catch::Contains(R"("key" : "seepage.time_scheme")"));
+  CHECK_THAT(json, Catch::Contains(R"("backward_euler")"));
+  CHECK_THAT(json, Catch::Contains(R"("expects" : "one of")"));
+  CHECK_THAT(json, Catch::Contains(R"("default" : true)"));
+  // Every key read appears once.
+  std::size_t keys = 0;
+  for (auto at = json.find(R"("key" :)"); at != std::string::npos; at = json.find(R"("key" :)", at + 1)) ++keys;
+  CHECK(keys == doc->records().size());
+}

@@ -1,0 +1,44 @@
+#!/usr/bin/python3
+"""Run a scene once under every word a choice key takes, as the program itself
+lists them (`PROGRAM SCENE --explain --format json`), so that a new scheme or
+acceleration is run here without a list in this file or in CMake. Every run
+must end with exit code 0; fewer than two choices fails (the key is then not
+a choice, or the program did not list it).
+
+usage: every_choice.py PROGRAM SCENE KEY WORK_DIR [--set key=value]...
+"""
+import json
+import os
+import subprocess
+import sys
+
+
+def choices(program, scene, key, overrides):
+    out = subprocess.run([program, scene, "--explain", "--format", "json"] + overrides, check=True,
+                         capture_output=True, text=True).stdout
+    for entry in json.loads(out)["keys"]:
+        if entry["key"] == key:
+            return entry["choices"]
+    sys.exit(f"{program} does not read {key} from {scene}")
+
+
+def main():
+    program, scene, key, work = sys.argv[1:5]
+    overrides = sys.argv[5:]
+    words = choices(program, scene, key, overrides)
+    if len(words) < 2:
+        sys.exit(f"{key} takes {words}: not a choice")
+    failed = []
+    for word in words:
+        command = [program, scene, "-q", "-o", os.path.join(work, word), "--overwrite",
+                   "--set", f'{key}="{word}"'] + overrides
+        code = subprocess.run(command, stdout=subprocess.DEVNULL).returncode
+        print(f"{key} = \"{word}\": exit code {code}")
+        if code != 0:
+            failed.append(word)
+    if failed:
+        sys.exit(f"failed under {', '.join(failed)}")
+
+
+if __name__ == "__main__":
+    main()
