@@ -32,10 +32,9 @@ double PermeabilityLaw::operator()(double lambda0, double compression, double da
 SeepageParticipant::SeepageParticipant(seepage::Solver& solver, GasSolidSettings settings)
     : solver_(solver), settings_(settings), lambda0_(solver.conductivity()) {
   const auto nc = static_cast<Eigen::Index>(solver_.mesh().num_cells());
-  occupancy_ = Eigen::VectorXd::Ones(nc);
-  stress_ = Eigen::VectorXd::Zero(3 * nc);
-  damage_ = Eigen::VectorXd::Zero(nc);
-  dilatation_ = Eigen::VectorXd::Zero(nc);
+  for (const auto& f : solid_fields)
+    received_[static_cast<std::size_t>(f.id)] =
+        Eigen::VectorXd::Constant(f.components * nc, f.id == SolidField::occupancy ? 1.0 : 0.0);
   if (settings_.biot_storage && solver_.model().law != seepage::Law::linear)
     throw std::invalid_argument("seepage: Biot storage needs the linear Darcy law (law = \"linear\")");
   if (settings_.fixed_stress > 0) {
@@ -48,20 +47,19 @@ SeepageParticipant::SeepageParticipant(seepage::Solver& solver, GasSolidSettings
 }
 
 void SeepageParticipant::write(const std::string& field, const Eigen::VectorXd& values) {
-  Eigen::VectorXd* target = field == "occupancy" ? &occupancy_
-                            : field == "stress"  ? &stress_
-                            : field == "damage"  ? &damage_
-                            : field == "dilatation" && settings_.biot_storage ? &dilatation_
-                                                 : nullptr;
-  if (!target) unknown_field(name(), field);
-  if (values.size() != target->size())
+  const auto f = std::find_if(solid_fields.begin(), solid_fields.end(), [&](const SolidFieldInfo& candidate) {
+    return candidate.name == field && candidate.sent(settings_);
+  });
+  if (f == solid_fields.end()) unknown_field(name(), field);
+  auto& target = received_[static_cast<std::size_t>(f->id)];
+  if (values.size() != target.size())
     throw std::invalid_argument(
-        fmt::format("seepage: field '{}' has {} values, expected {}", field, values.size(), target->size()));
-  *target = values;
+        fmt::format("seepage: field '{}' has {} values, expected {}", field, values.size(), target.size()));
+  target = values;
 }
 
 Eigen::VectorXd SeepageParticipant::read(const std::string& field) const {
-  if (field != "pressure") unknown_field(name(), field);
+  if (field != pressure_field) unknown_field(name(), field);
   const auto p = solver_.nodal_pressure();
   return Eigen::Map<const Eigen::VectorXd>(p.data(), static_cast<Eigen::Index>(p.size()));
 }
@@ -71,10 +69,13 @@ Eigen::VectorXd SeepageParticipant::read(const std::string& field) const {
 void SeepageParticipant::apply_solid_state() {
   const auto& mesh = solver_.mesh();
   const std::size_t nc = mesh.num_cells();
+  const auto& occupancy = received(SolidField::occupancy);
+  const auto& stress = received(SolidField::stress);
+  const auto& damage = received(SolidField::damage);
   std::vector<char> open(mesh.num_nodes(), 0);
   open_cells_ = 0;
   for (std::size_t c = 0; c < nc; ++c) {
-    if (occupancy_[static_cast<Eigen::Index>(c)] >= settings_.open_below) continue;
+    if (occupancy[static_cast<Eigen::Index>(c)] >= settings_.open_below) continue;
     ++open_cells_;
     for (int node : mesh.cells[c]) open[node] = 1;
   }
@@ -83,8 +84,8 @@ void SeepageParticipant::apply_solid_state() {
   std::vector<double> lambda(nc);
   for (std::size_t c = 0; c < nc; ++c) {
     const auto i = static_cast<Eigen::Index>(c);
-    const double compression = -smallest_principal(stress_[3 * i], stress_[3 * i + 1], stress_[3 * i + 2]);
-    lambda[c] = settings_.permeability(lambda0_[c], compression, std::clamp(damage_[i], 0.0, 1.0));
+    const double compression = -smallest_principal(stress[3 * i], stress[3 * i + 1], stress[3 * i + 2]);
+    lambda[c] = settings_.permeability(lambda0_[c], compression, std::clamp(damage[i], 0.0, 1.0));
   }
   solver_.set_conductivity(lambda);
 }
@@ -93,10 +94,11 @@ void SeepageParticipant::advance(double window) {
   apply_solid_state();
   if (settings_.biot_storage) {
     // The rate over the solid's last window, which matched the seepage's last.
-    std::vector<double> source(static_cast<std::size_t>(dilatation_.size()), 0.0);
+    const auto& dilatation = received(SolidField::dilatation);
+    std::vector<double> source(static_cast<std::size_t>(dilatation.size()), 0.0);
     if (last_size_ > 0)
       for (std::size_t c = 0; c < source.size(); ++c)
-        source[c] = -settings_.biot * dilatation_[static_cast<Eigen::Index>(c)] / last_size_;
+        source[c] = -settings_.biot * dilatation[static_cast<Eigen::Index>(c)] / last_size_;
     solver_.set_cell_source(std::move(source));
   }
   last_report_ = solver_.advance(window);
@@ -104,19 +106,15 @@ void SeepageParticipant::advance(double window) {
 }
 
 void SeepageParticipant::save_between_windows(checkpoint::Out out) const {
-  out.numbers("occupancy", occupancy_);
-  out.numbers("stress", stress_);
-  out.numbers("damage", damage_);
-  out.numbers("dilatation", dilatation_);
+  for (const auto& f : solid_fields) out.numbers(std::string(f.name), received(f.id));
   out.number("last_size", last_size_);
 }
 
 void SeepageParticipant::load_between_windows(const checkpoint::In& in) {
-  const auto cells = static_cast<std::size_t>(occupancy_.size());
-  occupancy_ = in.vector("occupancy", cells);
-  stress_ = in.vector("stress", 3 * cells);
-  damage_ = in.vector("damage", cells);
-  dilatation_ = in.vector("dilatation", cells);
+  for (const auto& f : solid_fields) {
+    auto& values = received_[static_cast<std::size_t>(f.id)];
+    values = in.vector(std::string(f.name), static_cast<std::size_t>(values.size()));
+  }
   last_size_ = in.number("last_size");
 }
 
@@ -138,6 +136,8 @@ SolidParticipant::SolidParticipant(mpm::Solver& solver, const MeshMapping& mappi
       pressure_end_(std::move(pressure)),
       felt_change_(Eigen::VectorXd::Zero(pressure_start_.size())),
       sends_dilatation_(settings.biot_storage) {
+  for (const auto& f : solid_fields)
+    if (f.id != SolidField::occupancy && f.sent(settings)) averaged_.push_back(f);
   if (pressure_start_.size() != static_cast<Eigen::Index>(mapping_.mesh().num_nodes()))
     throw std::invalid_argument("solid: the initial pressure does not match the seepage mesh");
   mark_window_start();
@@ -163,7 +163,7 @@ void SolidParticipant::make_initial_stress_effective(const std::vector<double>& 
 }
 
 void SolidParticipant::write(const std::string& field, const Eigen::VectorXd& values) {
-  if (field != "pressure") unknown_field(name(), field);
+  if (field != pressure_field) unknown_field(name(), field);
   if (values.size() != pressure_end_.size())
     throw std::invalid_argument(fmt::format("solid: field 'pressure' has {} values, expected {}", values.size(),
                                             pressure_end_.size()));
@@ -173,21 +173,31 @@ void SolidParticipant::write(const std::string& field, const Eigen::VectorXd& va
 void SolidParticipant::compute_averages() const {
   if (averages_) return;
   const auto& p = solver_.particles();
-  const std::size_t k = sends_dilatation_ ? 5 : 4;
+  std::size_t k = 0;
+  for (const auto& f : averaged_) k += static_cast<std::size_t>(f.components);
   std::vector<double> values(k * p.size());
   // Fixed stress: the volume change less (alpha / K_dr) times the change of
   // the pressure felt, beta / alpha = alpha / K_dr.
   const double felt_share = fixed_stress_ > 0 ? fixed_stress_ / biot_ : 0.0;
   for (std::size_t i = 0; i < p.size(); ++i) {
-    values[k * i] = p.stress[i](0, 0);
-    values[k * i + 1] = p.stress[i](1, 1);
-    values[k * i + 2] = p.stress[i](0, 1);
-    values[k * i + 3] = p.damage.empty() ? 0.0 : p.damage[i];
-    // Volume-weighted, this sums to the volume change over the window.
-    if (sends_dilatation_) {
-      values[k * i + 4] = (p.volume[i] - start_volume_[static_cast<std::size_t>(p.id[i])]) / p.volume[i];
-      if (felt_share > 0)
-        if (const auto felt = mapping_.sample(felt_change_, p.x[i])) values[k * i + 4] -= felt_share * felt->value;
+    double* out = &values[k * i];
+    for (const auto& f : averaged_) {
+      switch (f.id) {
+        case SolidField::stress:
+          out[0] = p.stress[i](0, 0);
+          out[1] = p.stress[i](1, 1);
+          out[2] = p.stress[i](0, 1);
+          break;
+        case SolidField::damage: out[0] = p.damage.empty() ? 0.0 : p.damage[i]; break;
+        case SolidField::dilatation:
+          // Volume-weighted, this sums to the volume change over the window.
+          out[0] = (p.volume[i] - start_volume_[static_cast<std::size_t>(p.id[i])]) / p.volume[i];
+          if (felt_share > 0)
+            if (const auto felt = mapping_.sample(felt_change_, p.x[i])) out[0] -= felt_share * felt->value;
+          break;
+        case SolidField::occupancy: break;  // the fraction itself, not a mean
+      }
+      out += f.components;
     }
   }
   averages_ = mapping_.average(p.x, p.volume, values, static_cast<int>(k));
@@ -197,15 +207,23 @@ Eigen::VectorXd SolidParticipant::read(const std::string& field) const {
   compute_averages();
   const auto& a = *averages_;
   const auto nc = static_cast<Eigen::Index>(a.fraction.size());
-  if (field == "occupancy") return Eigen::Map<const Eigen::VectorXd>(a.fraction.data(), nc);
-  const Eigen::Map<const Eigen::MatrixXd> mean(a.mean.data(), sends_dilatation_ ? 5 : 4, nc);
-  if (field == "stress") {
-    const Eigen::MatrixXd top = mean.topRows(3);
-    return Eigen::Map<const Eigen::VectorXd>(top.data(), 3 * nc);
+  const Eigen::Map<const Eigen::VectorXd> fraction(a.fraction.data(), nc);
+  if (field == name_of(SolidField::occupancy)) return fraction;
+  Eigen::Index row = 0, rows = 0;
+  for (const auto& f : averaged_) rows += f.components;
+  const Eigen::Map<const Eigen::MatrixXd> mean(a.mean.data(), rows, nc);
+  for (const auto& f : averaged_) {
+    if (f.name != field) {
+      row += f.components;
+      continue;
+    }
+    const Eigen::MatrixXd block = mean.middleRows(row, f.components);
+    const Eigen::Map<const Eigen::VectorXd> cellwise(block.data(), f.components * nc);
+    // The dilatation is a volume change per cell area: the mean over the
+    // solid times its fraction.
+    if (f.id == SolidField::dilatation) return cellwise.cwiseProduct(fraction);
+    return cellwise;
   }
-  if (field == "damage") return mean.row(3).transpose();
-  if (field == "dilatation" && sends_dilatation_)
-    return mean.row(4).transpose().cwiseProduct(Eigen::Map<const Eigen::VectorXd>(a.fraction.data(), nc));
   unknown_field(name(), field);
 }
 

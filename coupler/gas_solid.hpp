@@ -23,7 +23,9 @@
 //     alpha^2 / K_dr cancels at convergence and what it takes depends only
 //     on what the coupling hands it (an accelerated iteration needs that).
 
+#include <array>
 #include <optional>
+#include <string_view>
 #include <vector>
 
 #include "coupler/coupling.hpp"
@@ -76,6 +78,34 @@ struct GasSolidSettings {
   stability::Pressure window_pressure = stability::Pressure::ramp;
 };
 
+// The fields the solid sends the seepage, each declared once: the solid's
+// cell averaging, the seepage's storage and checkpoint, and the coupling's
+// stacking and convergence measures (coupler/scene_reader.cpp) all run over
+// this table. Seepage to solid goes one field, `pressure_field`.
+enum class SolidField { occupancy, stress, damage, dilatation };
+struct SolidFieldInfo {
+  SolidField id;
+  std::string_view name;  // the coupling's and the checkpoint's
+  int components;         // values per seepage cell
+  std::string_view unit;
+  // Whether a coupled run with these settings sends it (a one-way scheme
+  // sends nothing back).
+  bool (*sent)(const GasSolidSettings&);
+};
+inline constexpr std::string_view pressure_field = "pressure";  // nodal p [Pa]
+// In the order they stack.
+inline constexpr std::array<SolidFieldInfo, 4> solid_fields{{
+    {SolidField::occupancy, "occupancy", 1, "1", [](const GasSolidSettings&) { return true; }},
+    {SolidField::stress, "stress", 3, "Pa", [](const GasSolidSettings& g) { return g.permeability_coupling; }},
+    {SolidField::damage, "damage", 1, "1", [](const GasSolidSettings& g) { return g.permeability_coupling; }},
+    {SolidField::dilatation, "dilatation", 1, "1", [](const GasSolidSettings& g) { return g.biot_storage; }},
+}};
+constexpr std::string_view name_of(SolidField field) {
+  for (const auto& f : solid_fields)
+    if (f.id == field) return f.name;
+  return {};
+}
+
 class SeepageParticipant final : public Participant {
  public:
   SeepageParticipant(seepage::Solver& solver, GasSolidSettings settings);
@@ -102,7 +132,10 @@ class SeepageParticipant final : public Participant {
   seepage::Solver& solver_;
   GasSolidSettings settings_;
   std::vector<double> lambda0_;  // the scene's conductivity per cell
-  Eigen::VectorXd occupancy_, stress_, damage_, dilatation_;
+  // What the solid last sent, per field of solid_fields (unsent ones keep
+  // their start: full occupancy, no stress, no damage, no dilatation).
+  std::array<Eigen::VectorXd, solid_fields.size()> received_;
+  const Eigen::VectorXd& received(SolidField f) const { return received_[static_cast<std::size_t>(f)]; }
   // The size of the last advance: the solid's dilatation covers the window
   // it last took, which had this size (the previous iterate of this window,
   // or the previous window in a one-pass scheme).
@@ -157,6 +190,9 @@ class SolidParticipant final : public Participant {
   Eigen::VectorXd pressure_start_, pressure_end_, pressure_now_;
   Eigen::VectorXd felt_change_;  // the pressure felt at the last window's end less at its start
   std::vector<int> cell_hint_;  // per particle, the seepage cell it was last found in
+  // The cell means it sends (solid_fields less occupancy, which is the
+  // fraction itself), in stacking order.
+  std::vector<SolidFieldInfo> averaged_;
   bool sends_dilatation_;
   std::vector<double> start_volume_;  // per particle id, at the window's start
   mpm::StepInfo last_window_{0};

@@ -21,7 +21,7 @@ CouplingSetup read_coupling(const scene::Table& c) {
        {"implicit", SchemeSettings::Kind::implicit}});
   s.window = c.quantity({"window", "coupling window: one seepage step, many MPM steps", "", Range::positive()},
                         units::time);
-  sc.to_second = {"pressure"};
+  sc.to_second = {std::string(pressure_field)};
 
   // Defaults are the settings structs' own, written here as a scene would.
   const SchemeSettings scheme_default;
@@ -81,10 +81,13 @@ CouplingSetup read_coupling(const scene::Table& c) {
                                        gas_default.permeability_coupling ? "true" : "false"});
   // Only what the seepage uses crosses over (and is iterated on).
   if (sc.kind != SchemeSettings::Kind::one_way) {
-    sc.to_first = {{"occupancy", rel, fraction_floor}};
-    if (g.permeability_coupling)
-      sc.to_first.insert(sc.to_first.end(), {{"stress", rel, stress_floor}, {"damage", rel, fraction_floor}});
-    if (g.biot_storage) sc.to_first.push_back({"dilatation", rel, dilatation_floor});
+    for (const auto& f : solid_fields) {
+      if (!f.sent(g)) continue;
+      const double floor = f.id == SolidField::stress       ? stress_floor
+                           : f.id == SolidField::dilatation ? dilatation_floor
+                                                            : fraction_floor;
+      sc.to_first.push_back({std::string(f.name), rel, floor});
+    }
   }
 
   auto& a = sc.acceleration;

@@ -61,3 +61,18 @@ TEST_CASE("a coupled scene whose seepage mesh reaches past the MPM grid is refus
                                                       Catch::Contains("reaches 18 m past the grid's right edge (x = 6 m)"));
   CHECK_THROWS_WITH(setup(R"(["-1 m", "1 m"])"), Catch::Contains("1 m past the grid's left edge (x = 0 m)"));
 }
+
+TEST_CASE("the solid sends the seepage only the fields the scene's physics use", "[scene][coupling]") {
+  const auto sent = [](const std::string& extra) {
+    auto doc = scene::Document::parse("window = \"1 ms\"\n" + extra, "coupling.toml");
+    const auto setup = coupling::read_coupling(doc->root());
+    std::vector<std::string> names;
+    for (const auto& c : setup.scheme.to_first) names.push_back(c.field);
+    return names;
+  };
+  using V = std::vector<std::string>;
+  CHECK(sent("") == V{"occupancy", "stress", "damage"});
+  CHECK(sent("permeability_coupling = false") == V{"occupancy"});
+  CHECK(sent("biot_storage = true\npermeability_coupling = false") == V{"occupancy", "dilatation"});
+  CHECK(sent("scheme = \"one_way\"").empty());
+}
