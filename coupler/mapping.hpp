@@ -17,27 +17,26 @@
 
 #include <Eigen/Core>
 
-#include "seepage_fe/cell_locator.hpp"
-#include "seepage_fe/mesh.hpp"
-#include "seepage_fe/q1.hpp"
+#include "seepage_fe/sampling.hpp"
 
 namespace outburst::coupling {
 
 class MeshMapping {
  public:
-  explicit MeshMapping(seepage::Mesh mesh);
-  MeshMapping(const MeshMapping&) = delete;  // the locator refers into mesh_
-  MeshMapping& operator=(const MeshMapping&) = delete;
+  // Reads the mesh through the seepage's sampler, which must outlive it.
+  explicit MeshMapping(const seepage::Sampler& sampler) : sampler_(sampler) {}
 
-  const seepage::Mesh& mesh() const { return mesh_; }
-  const std::vector<double>& cell_area() const { return area_; }
+  const seepage::Mesh& mesh() const { return sampler_.mesh(); }
+  const std::vector<double>& cell_area() const { return sampler_.cell_area(); }
 
-  using Sample = seepage::q1::Sample;
+  using Sample = seepage::Sampler::Value;
   // Nodal field and its gradient at x; nullopt outside the mesh. `hint`: the
-  // cell to try first, updated (see CellLocator::locate).
-  std::optional<Sample> sample(const Eigen::VectorXd& nodal, const Eigen::Vector2d& x, int* hint = nullptr) const;
+  // cell to try first, updated (see seepage::Sampler::sample).
+  std::optional<Sample> sample(const Eigen::VectorXd& nodal, const Eigen::Vector2d& x, int* hint = nullptr) const {
+    return sampler_.sample(nodal, x, hint);
+  }
   // The cell holding x, or -1.
-  int cell_of(const Eigen::Vector2d& x) const;
+  int cell_of(const Eigen::Vector2d& x) const { return sampler_.cell_of(x); }
 
   // Volume-weighted cell averages of `components` values per point
   // (values[p * components + k]); cells without points get 0. Also returns the
@@ -50,9 +49,7 @@ class MeshMapping {
                    const std::vector<double>& values, int components) const;
 
  private:
-  seepage::Mesh mesh_;
-  seepage::CellLocator locator_;
-  std::vector<double> area_;
+  const seepage::Sampler& sampler_;
 };
 
 }  // namespace outburst::coupling

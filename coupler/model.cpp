@@ -186,10 +186,12 @@ CoupledModel::CoupledModel(CoupledSetup setup, bool settle_later) : setup_(std::
   auto& seep = setup_.seepage;
   auto& solid = setup_.solid;
   const CouplingSetup& cs = setup_.coupling;
-  seepage_ = std::make_unique<seepage::Solver>(seep.mesh, seep.model, seep.settings);
+  // The solver keeps the one copy of the mesh; the mapping reads it through
+  // the solver's sampler.
+  seepage_ = std::make_unique<seepage::Solver>(std::move(seep.mesh), seep.model, seep.settings);
   solid_ = std::make_unique<mpm::Solver>(solid.grid, std::move(solid.materials), std::move(solid.particles),
                                          solid.settings);
-  mapping_ = std::make_unique<MeshMapping>(seep.mesh);
+  mapping_ = std::make_unique<MeshMapping>(seepage_->sampler());
   GasSolidSettings gas_solid = cs.gas_solid;
   if (cs.fixed_stress_split.value_or(false)) {
     double bulk = std::numeric_limits<double>::infinity();

@@ -52,6 +52,7 @@ class CoupledModel {
   // One coupling window, cut short at `limit`.
   const WindowRecord& advance(double limit);
 
+  // The scene's settings; its mesh and particles now live in the solvers.
   const CoupledSetup& setup() const { return setup_; }
   seepage::Solver& seepage() { return *seepage_; }
   mpm::Solver& solid() { return *solid_; }

@@ -46,7 +46,7 @@ Solver::Solver(Mesh mesh, Model model, Settings settings)
     : mesh_(std::move(mesh)),
       model_(std::move(model)),
       settings_(settings),
-      locator_(mesh_) {
+      sampler_(mesh_) {
   if (model_.materials.size() != mesh_.region_names.size())
     throw std::invalid_argument(fmt::format("the mesh has {} regions but the model {} materials",
                                             mesh_.region_names.size(), model_.materials.size()));
@@ -482,22 +482,17 @@ StepReport Solver::advance(double dt) {
 bool Solver::supernodal() const { return mesh_.num_nodes() >= supernodal_threshold; }
 
 std::optional<double> Solver::pressure_at(const Eigen::Vector2d& x) const {
-  const auto hit = locator_.locate(x);
-  if (!hit) return std::nullopt;
-  const auto n = q1::shape(hit->reference.x(), hit->reference.y());
-  double u = 0;
-  for (int a = 0; a < 4; ++a) u += n[a] * u_[mesh_.cells[hit->cell][a]];
-  return pressure_from_unknown(model_.law, u);
+  const auto s = sampler_.sample(u_, x);
+  if (!s) return std::nullopt;
+  return pressure_from_unknown(model_.law, s->value);
 }
 
 std::optional<Eigen::Vector2d> Solver::pressure_gradient_at(const Eigen::Vector2d& x) const {
-  const auto hit = locator_.locate(x);
-  if (!hit) return std::nullopt;
-  const auto cell = static_cast<std::size_t>(hit->cell);
-  const auto s = q1::sample(mesh_.corners(cell), mesh_.cells[cell], u_, hit->reference);
-  if (model_.law == Law::linear) return s.gradient;
+  const auto s = sampler_.sample(u_, x);
+  if (!s) return std::nullopt;
+  if (model_.law == Law::linear) return s->gradient;
   // grad p = grad P / (2 p)
-  return s.gradient / (2.0 * std::sqrt(std::max(s.value, 1e-300)));
+  return s->gradient / (2.0 * std::sqrt(std::max(s->value, 1e-300)));
 }
 
 std::vector<double> Solver::nodal_pressure() const {

@@ -9,6 +9,7 @@
 //   s.set_conductivity(per_cell);   // optional: the coupler's lambda per cell
 //   s.advance(dt);                  // one step, cut and retried if it fails
 //   s.pressure_at(x), s.pressure_gradient_at(x)
+//   s.sampler().sample(field, x)          // any nodal field at a point
 //   auto st = s.save_state(); ...; s.restore_state(st);   // coupling sub-iterations
 
 #include <functional>
@@ -21,9 +22,9 @@
 #include <Eigen/SparseCore>
 
 #include "common/checkpoint.hpp"
-#include "seepage_fe/cell_locator.hpp"
 #include "seepage_fe/mesh.hpp"
 #include "seepage_fe/model.hpp"
+#include "seepage_fe/sampling.hpp"
 
 namespace outburst::seepage {
 
@@ -73,7 +74,7 @@ struct Timings {
 class Solver {
  public:
   Solver(Mesh mesh, Model model, Settings settings);
-  // The cell locator and the factorisation refer into the solver: it stays put.
+  // The sampler and the factorisation refer into the solver: it stays put.
   Solver(const Solver&) = delete;
   Solver& operator=(const Solver&) = delete;
 
@@ -127,6 +128,8 @@ class Solver {
 
   // ---- results
   const Mesh& mesh() const { return mesh_; }
+  // Reads nodal fields of this mesh at points, and finds the cell of a point.
+  const Sampler& sampler() const { return sampler_; }
   const Model& model() const { return model_; }
   const Eigen::VectorXd& unknown() const { return u_; }  // P (gas) or p (linear)
   std::vector<double> nodal_pressure() const;           // p [Pa]
@@ -154,7 +157,7 @@ class Solver {
   Mesh mesh_;
   Model model_;
   Settings settings_;
-  CellLocator locator_;
+  Sampler sampler_;
 
   // Geometry, computed once.
   std::vector<Eigen::Matrix4d> cell_stiffness_;  // unit conductivity

@@ -15,8 +15,9 @@ using namespace outburst::testing;
 
 TEST_CASE("mesh to points reproduces a linear field and its gradient exactly", "[coupler][mapping]") {
   const double a = 3.0, bx = -2.0, by = 0.7;
-  const auto check = [&](seepage::Mesh mesh, const char* what) {
-    const MeshMapping map(std::move(mesh));
+  const auto check = [&](const seepage::Mesh& mesh, const char* what) {
+    const seepage::Sampler sampler(mesh);
+    const MeshMapping map(sampler);
     Eigen::VectorXd nodal(static_cast<Eigen::Index>(map.mesh().num_nodes()));
     for (std::size_t i = 0; i < map.mesh().num_nodes(); ++i)
       nodal[static_cast<Eigen::Index>(i)] = a + bx * map.mesh().nodes[i].x() + by * map.mesh().nodes[i].y();
@@ -49,7 +50,9 @@ TEST_CASE("mesh to points reproduces a linear field and its gradient exactly", "
 }
 
 TEST_CASE("points to mesh: volume fractions and averages conserve what they average", "[coupler][mapping]") {
-  const MeshMapping map(rectangle_problem(seepage::Law::gas, {4, 2}, {8, 4}, {1, 1, 1}, {}, {2.0, 1.0}).mesh);
+  const seepage::Mesh mesh = rectangle_problem(seepage::Law::gas, {4, 2}, {8, 4}, {1, 1, 1}, {}, {2.0, 1.0}).mesh;
+  const seepage::Sampler sampler(mesh);
+  const MeshMapping map(sampler);
   std::mt19937 random(3);
   std::uniform_real_distribution<double> u(0, 1);
   std::vector<Eigen::Vector2d> x;
@@ -103,7 +106,7 @@ TEST_CASE("one-way: a column under a linear gas pressure settles to the analytic
   gs.biot = alpha;
   gs.permeability_coupling = false;
   SeepageParticipant seepage_side(seep, gs);
-  const MeshMapping map(seep.mesh());
+  const MeshMapping map(seep.sampler());
   SolidParticipant solid_side(solid, map, gs, seepage_side.read("pressure"), std::nullopt);
   SchemeSettings scheme;
   scheme.kind = SchemeSettings::Kind::one_way;

@@ -1,0 +1,25 @@
+#include "seepage_fe/sampling.hpp"
+
+#include "seepage_fe/q1.hpp"
+
+namespace outburst::seepage {
+
+Sampler::Sampler(const Mesh& mesh) : mesh_(mesh), locator_(mesh), area_(mesh.num_cells()) {
+  for (std::size_t c = 0; c < mesh_.num_cells(); ++c) area_[c] = q1::integrals(mesh_.corners(c)).lumped.sum();
+}
+
+std::optional<Sampler::Value> Sampler::sample(const Eigen::VectorXd& nodal, const Eigen::Vector2d& x,
+                                              int* hint) const {
+  const auto hit = locator_.locate(x, hint);
+  if (!hit) return std::nullopt;
+  const auto c = static_cast<std::size_t>(hit->cell);
+  const auto s = q1::sample(mesh_.corners(c), mesh_.cells[c], nodal, hit->reference);
+  return Value{s.value, s.gradient};
+}
+
+int Sampler::cell_of(const Eigen::Vector2d& x, int* hint) const {
+  const auto hit = locator_.locate(x, hint);
+  return hit ? hit->cell : -1;
+}
+
+}  // namespace outburst::seepage
