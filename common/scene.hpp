@@ -130,6 +130,23 @@ class Table {
       if (o.first == word) return o.second;
     throw std::logic_error("scene: a checked choice matched no option");
   }
+  // One of a registry's models (each with a name and a description, see
+  // common/registry.hpp); the key's help is `doc` followed by the models.
+  template <class Model>
+  const Model& model(std::string_view key, std::string_view doc, std::string_view fallback,
+                     const std::vector<Model>& models) const {
+    std::vector<std::string_view> names;
+    std::string help(doc);
+    for (const auto& m : models) {
+      names.push_back(m.name);
+      help += std::string(names.size() == 1 ? ": " : ", ") + "\"" + std::string(m.name) + "\" (" +
+              std::string(m.description) + ")";
+    }
+    const std::string word = choice({key, help, fallback}, names);
+    for (const auto& m : models)
+      if (m.name == word) return m;
+    throw std::logic_error("scene: a checked choice matched no model");
+  }
   std::vector<std::string> choice_list(const Key& key,
                                        const std::vector<std::string_view>& choices) const;
   // A file path, resolved relative to the scene file's folder.

@@ -18,9 +18,9 @@
 // iteration (a per-window scaling; V and W are kept unscaled).
 
 #include <cstddef>
-#include <deque>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <Eigen/Core>
@@ -36,8 +36,9 @@ struct FieldSlice {
 };
 
 struct AccelerationSettings {
-  enum class Kind { constant, aitken, iqn_ils };
-  Kind kind = Kind::iqn_ils;
+  // A registered model's name (acceleration_models(); the scene key
+  // `coupling.acceleration`).
+  std::string kind = "iqn_ils";
   // constant: the factor; Aitken and IQN-ILS: the factor of each window's first
   // iteration (IQN-ILS only while it has no columns yet).
   double relaxation = 0.5;
@@ -72,44 +73,23 @@ class Acceleration {
   int iteration_ = 0;  // within the window, counted by next()
 };
 
+// An acceleration a scene can name (`acceleration = "<name>"` in
+// [coupling]), each in its own file under coupler/accelerations/ with its
+// registration, so that a new one is one file and its test.
+struct AccelerationModel {
+  std::string_view name;
+  std::string_view description;  // a few words for the key's help
+  std::unique_ptr<Acceleration> (*make)(const AccelerationSettings& settings);
+};
+
+// The models registered, by name. The list is taken at the first call: not to
+// be called during static initialisation.
+const std::vector<AccelerationModel>& acceleration_models();
+// Adds a model; each model's file calls it once, at static initialisation:
+// `[[maybe_unused]] const bool registered = register_acceleration({...});`.
+// Two models of one name are a programming error (std::logic_error).
+bool register_acceleration(const AccelerationModel& model);
+// The model `settings.kind` names (std::invalid_argument for an unknown name).
 std::unique_ptr<Acceleration> make_acceleration(const AccelerationSettings& settings);
-
-class ConstantRelaxation final : public Acceleration {
- public:
-  explicit ConstantRelaxation(double omega) : omega_(omega) {}
-  Eigen::VectorXd next(const Eigen::VectorXd& y, const Eigen::VectorXd& x) override;
-
- private:
-  double omega_;
-};
-
-class Aitken final : public Acceleration {
- public:
-  explicit Aitken(double initial) : initial_(initial) {}
-  void start_window(const std::vector<FieldSlice>& fields) override;
-  Eigen::VectorXd next(const Eigen::VectorXd& y, const Eigen::VectorXd& x) override;
-
- private:
-  double initial_, omega_ = 0;
-  Eigen::VectorXd previous_residual_;
-};
-
-class IqnIls final : public Acceleration {
- public:
-  explicit IqnIls(const AccelerationSettings& settings) : settings_(settings) {}
-  void start_window(const std::vector<FieldSlice>& fields) override;
-  Eigen::VectorXd next(const Eigen::VectorXd& y, const Eigen::VectorXd& x) override;
-  void end_window(bool converged) override;
-  // The columns of the past windows kept for reuse.
-  void save(checkpoint::Out out) const override;
-  void load(const checkpoint::In& in) override;
-
- private:
-  AccelerationSettings settings_;
-  // Columns of this window, newest first, and of past windows.
-  std::deque<Eigen::VectorXd> v_, w_;
-  std::deque<std::deque<Eigen::VectorXd>> past_v_, past_w_;
-  Eigen::VectorXd previous_residual_, previous_output_;
-};
 
 }  // namespace outburst::coupling

@@ -91,12 +91,9 @@ CouplingSetup read_coupling(const scene::Table& c) {
   }
 
   auto& a = sc.acceleration;
-  a.kind = c.choice<AccelerationSettings::Kind>(
-      {"acceleration", "implicit: \"iqn_ils\" (quasi-Newton), \"aitken\" or \"constant\" (under-relaxation)",
-       "iqn_ils"},
-      {{"iqn_ils", AccelerationSettings::Kind::iqn_ils},
-       {"aitken", AccelerationSettings::Kind::aitken},
-       {"constant", AccelerationSettings::Kind::constant}});
+  a.kind = c.model("acceleration", "implicit: what proposes each sub-iteration's input", a.kind,
+                   acceleration_models())
+               .name;
   a.relaxation = c.number({"relaxation", "constant: the factor; Aitken and IQN-ILS: that of a window's first "
                                          "iteration",
                            text(acceleration_default.relaxation), Range{0.0, 1.0, false, true}});

@@ -1,11 +1,9 @@
 #include "mpm_solid/material.hpp"
 
-#include <cmath>
 #include <algorithm>
-#include <map>
-#include <stdexcept>
+#include <cmath>
 
-#include <fmt/format.h>
+#include "common/registry.hpp"
 
 namespace outburst::mpm {
 
@@ -34,28 +32,8 @@ std::pair<double, double> DruckerPragerFit::coefficients(Kind kind, double c, do
   return {0, 0};
 }
 
-namespace {
+bool register_material(const MaterialModel& model) { return Registry<MaterialModel>::add(model, "material models"); }
 
-std::map<std::string_view, MaterialModel>& registry() {
-  static std::map<std::string_view, MaterialModel> models;
-  return models;
-}
-
-}  // namespace
-
-bool register_material(const MaterialModel& model) {
-  if (!registry().emplace(model.name, model).second)
-    throw std::logic_error(fmt::format("two material models named \"{}\"", model.name));
-  return true;
-}
-
-const std::vector<MaterialModel>& material_models() {
-  static const std::vector<MaterialModel> models = [] {
-    std::vector<MaterialModel> v;
-    for (const auto& [name, model] : registry()) v.push_back(model);
-    return v;
-  }();
-  return models;
-}
+const std::vector<MaterialModel>& material_models() { return Registry<MaterialModel>::all(); }
 
 }  // namespace outburst::mpm

@@ -273,20 +273,12 @@ Setup read_setup(const scene::Table& s) {
     const std::string name = m.string({"name", "material name"});
     if (std::find(names.begin(), names.end(), name) != names.end())
       m.fail("name", fmt::format("material \"{}\" is defined twice", name));
-    std::vector<std::string_view> models;
-    std::string described;
-    for (const auto& model : material_models()) {
-      models.push_back(model.name);
-      described += fmt::format("{}\"{}\" ({})", described.empty() ? "" : ", ", model.name, model.description);
-    }
-    const std::string model = m.choice({"model", described, "elastic"}, models);
+    const MaterialModel& model = m.model("model", "constitutive model", "elastic", material_models());
     Elasticity e{};
     e.density = m.quantity({"density", "mass density", "", Range::positive()}, units::density);
     e.youngs_modulus = m.quantity({"youngs_modulus", "Young's modulus E", "", Range::positive()}, units::pressure);
     e.poisson_ratio = m.number({"poisson_ratio", "Poisson's ratio", "", Range{-1.0, 0.5, false, false}});
-    const auto& reader = *std::find_if(material_models().begin(), material_models().end(),
-                                       [&](const MaterialModel& candidate) { return candidate.name == model; });
-    setup.materials.push_back(reader.read(m, {name, e, setup.grid.h}));
+    setup.materials.push_back(model.read(m, {name, e, setup.grid.h}));
     names.push_back(name);
   }
   if (names.empty()) s.fail("materials", "give at least one [[mpm.materials]]");

@@ -2,9 +2,15 @@
 // coupling scheme's protocol with participants that record what happens.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string_view>
+#include <vector>
 
+#include "coupler/accelerations/aitken.hpp"
+#include "coupler/accelerations/constant.hpp"
+#include "coupler/accelerations/iqn_ils.hpp"
 #include "coupler/coupling.hpp"
 
 using namespace outburst::coupling;
@@ -156,7 +162,7 @@ TEST_CASE("coupling schemes: one-way and explicit pass once, implicit repeats to
     // first: x = y + 1; second: y = -0.4 x; fixed point y = -0.4 / 1.4.
     Mock first("first", 1, 1), second("second", -0.4, 0);
     s.kind = SchemeSettings::Kind::implicit;
-    s.acceleration.kind = AccelerationSettings::Kind::aitken;
+    s.acceleration.kind = "aitken";
     Coupling c(first, second, s);
     const auto& r = c.advance(1);
     CHECK(r.converged);
@@ -171,7 +177,7 @@ TEST_CASE("coupling: a non-finite field stops the window naming it, and a diverg
   s.kind = SchemeSettings::Kind::implicit;
   s.to_second = {"a"};
   s.to_first = {{"stress", 1e-10, 0}};
-  s.acceleration.kind = AccelerationSettings::Kind::constant;
+  s.acceleration.kind = "constant";
   s.acceleration.relaxation = 1.0;
   s.max_iterations = 5;
   SECTION("NaN") {
@@ -191,4 +197,19 @@ TEST_CASE("coupling: a non-finite field stops the window naming it, and a diverg
     CHECK_FALSE(r.converged);
     CHECK(r.iterations == 5);
   }
+}
+
+TEST_CASE("a scene names a registered acceleration, and an unknown name is refused with it", "[coupler][acceleration]") {
+  std::vector<std::string_view> names;
+  for (const auto& model : acceleration_models()) names.push_back(model.name);
+  for (const char* name : {"aitken", "constant", "iqn_ils"}) {
+    CHECK(std::find(names.begin(), names.end(), name) != names.end());
+    AccelerationSettings s;
+    s.kind = name;
+    CHECK(make_acceleration(s) != nullptr);
+  }
+  CHECK(std::is_sorted(names.begin(), names.end()));
+  AccelerationSettings unknown;
+  unknown.kind = "anderson";
+  CHECK_THROWS_WITH(make_acceleration(unknown), Catch::Contains("anderson"));
 }

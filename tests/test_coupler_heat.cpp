@@ -18,7 +18,7 @@ struct HeatRun {
   bool all_converged;
 };
 
-HeatRun run_heat(AccelerationSettings::Kind kind, double relaxation) {
+HeatRun run_heat(const char* kind, double relaxation) {
   const double dt = 0.1;
   HeatHalf left(HeatHalf::Side::dirichlet, 10, dt), right(HeatHalf::Side::neumann, 10, dt);
   SchemeSettings s;
@@ -45,12 +45,12 @@ TEST_CASE("partitioned heat: every acceleration matches the exact solution, in n
           "[coupler][heat]") {
   struct Row {
     const char* name;
-    AccelerationSettings::Kind kind;
+    const char* kind;
     double relaxation, precice_iterations;
   };
-  const Row rows[] = {{"constant 0.5", AccelerationSettings::Kind::constant, 0.5, 28.5},
-                      {"Aitken", AccelerationSettings::Kind::aitken, 0.5, 16},
-                      {"IQN-ILS", AccelerationSettings::Kind::iqn_ils, 0.1, 5}};
+  const Row rows[] = {{"constant 0.5", "constant", 0.5, 28.5},
+                      {"Aitken", "aitken", 0.5, 16},
+                      {"IQN-ILS", "iqn_ils", 0.1, 5}};
   std::printf("\npartitioned heat, 10 windows of 0.1, relative tolerance 1e-10\n%-14s %12s %10s %12s\n",
               "acceleration", "iterations", "preCICE", "max error");
   for (const auto& row : rows) {
