@@ -1,8 +1,7 @@
-#!/usr/bin/python3
 """Accuracy against wall time for one scene: sweep solver knobs, measure each
 run's error, and show which knob buys accuracy cheapest.
 
-usage: study.py STUDY.toml [--out DIR] [--jobs N] [--threads T] [--build build] [--check]
+usage: python3 -m cases.study STUDY.toml [--out DIR] [--jobs N] [--threads T] [--build build] [--check]
 
 STUDY.toml names the scene, the program, a measure module and the knobs:
 
@@ -41,6 +40,7 @@ log value and against log wall time, with R^2 of the fit.
 import argparse
 import concurrent.futures
 import csv
+import importlib
 import importlib.util
 import itertools
 import math
@@ -48,10 +48,11 @@ import os
 import re
 import subprocess
 import sys
-import time
 import tomllib
 
 import numpy as np
+
+from .runs import REFUSED, run_one, write_rows
 
 
 class StudyError(Exception):
@@ -161,6 +162,25 @@ class Knob:
         return [f"{self.key}={toml_value(value)}"]
 
 
+CASES = os.path.dirname(os.path.abspath(__file__))
+
+
+def load_measure(path):
+    """A measure module from its file. One inside this package is imported by
+    its module name, so that its package imports resolve; one elsewhere (a
+    user's own, a test's) is loaded from its file alone."""
+    path = os.path.abspath(path)
+    if os.path.commonpath([path, CASES]) == CASES:
+        inner = os.path.splitext(os.path.relpath(path, CASES))[0]
+        return importlib.import_module(".".join([__package__] + inner.split(os.sep)))
+    module_spec = importlib.util.spec_from_file_location(os.path.splitext(os.path.basename(path))[0], path)
+    if module_spec is None:
+        raise StudyError(f"measure: {path} is not a Python module")
+    measure = importlib.util.module_from_spec(module_spec)
+    module_spec.loader.exec_module(measure)
+    return measure
+
+
 def load_study(path):
     try:
         with open(path, "rb") as f:
@@ -186,14 +206,10 @@ def load_study(path):
     for name in spec_ref:
         if name not in names:
             raise StudyError(f"{path}: reference.{name} is not one of the knobs ({', '.join(sorted(names))})")
-    measure_path = os.path.join(here, spec["measure"]) if "measure" in spec else \
-        os.path.join(os.path.dirname(os.path.abspath(__file__)), "generic_measure.py")
-    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))  # run_output for the measures
-    module_spec = importlib.util.spec_from_file_location("measure", measure_path)
-    if module_spec is None or not os.path.exists(measure_path):
+    measure_path = os.path.join(here, spec.get("measure", os.path.join(CASES, "generic_measure.py")))
+    if not os.path.isfile(measure_path):
         raise StudyError(f"{path}: measure: no module {measure_path}")
-    measure = importlib.util.module_from_spec(module_spec)
-    module_spec.loader.exec_module(measure)
+    measure = load_measure(measure_path)
     if not hasattr(measure, "errors") and not hasattr(measure, "quantities"):
         raise StudyError(f"{measure_path}: defines neither errors(run_dir) nor quantities(run_dir)")
     if not hasattr(measure, "errors") and not spec_ref:
@@ -213,41 +229,6 @@ def program_path(program, build, study_dir):
     if program not in where:
         raise StudyError(f"program \"{program}\": expected seepage-fe, mpm-solid, outburst or a path")
     return os.path.join(build, where[program], program)
-
-
-# The programs' exit code for a valid scene refused because what it asks for
-# cannot work in its regime (common/program.hpp).
-REFUSED = 4
-
-
-def write_rows(path, rows):
-    """Rows of dicts to a CSV whose columns are every key, in the order first met."""
-    fields = []
-    for r in rows:
-        fields += [k for k in r if k not in fields]
-    with open(path, "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=fields)
-        w.writeheader()
-        w.writerows(rows)
-
-
-def run_one(program, scene, overrides, directory, threads):
-    """Runs a program on a scene with overrides; its wall time and, if it failed, its last message."""
-    # Studies rerun into their folders: the earlier run's files are replaced.
-    command = [program, scene, "-q", "-o", directory, "--overwrite"]
-    for o in overrides:
-        command += ["--set", o]
-    env = dict(os.environ, OMP_NUM_THREADS=str(threads))
-    start = time.monotonic()
-    done = subprocess.run(command, capture_output=True, text=True, env=env)
-    wall = time.monotonic() - start
-    note = ""
-    if done.returncode != 0:
-        lines = (done.stderr or done.stdout).strip().splitlines()
-        note = lines[-1] if lines else f"exit code {done.returncode}"
-        if done.returncode == REFUSED:
-            note = "refused: " + note.split("] ")[-1]
-    return wall, note
 
 
 def fit(x, y):

@@ -23,9 +23,10 @@ def main():
     failures = []
     for scene, end, expected in CASES:
         out = os.path.join(work, scene.split("/")[0])
-        done = subprocess.run([sys.executable, os.path.join(source, "cases", "effect_cost.py"),
+        done = subprocess.run([sys.executable, "-m", "cases.effect_cost",
                                os.path.join(source, "cases", scene), "--set", f"scene.end_time={end}",
-                               "--repeats", "1", "--build", build, "--out", out], capture_output=True, text=True)
+                               "--repeats", "1", "--build", build, "--out", out], capture_output=True, text=True,
+                              cwd=source)
         if done.returncode != 0:
             failures.append(f"{scene}: {done.stderr.strip()}")
             continue

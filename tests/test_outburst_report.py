@@ -44,8 +44,8 @@ def check(failures, name, value, low, high):
 
 def main():
     source, run_dir = sys.argv[1], sys.argv[2]
-    sys.path.insert(0, os.path.join(source, "cases", "outburst"))
-    import report
+    sys.path.insert(0, source)
+    from cases.outburst import report
     failures = []
     x0 = seam()
 
@@ -78,8 +78,8 @@ def main():
     check(failures, "loosened seam: fill", loose["fill"], 0.78, 0.82)
 
     # The report from a run: every row and figure written.
-    subprocess.run([sys.executable, os.path.join(source, "cases", "outburst", "report.py"), run_dir], check=True,
-                   stdout=subprocess.DEVNULL)
+    subprocess.run([sys.executable, "-m", "cases.outburst.report", run_dir], check=True, stdout=subprocess.DEVNULL,
+                   cwd=source)
     text = open(os.path.join(run_dir, "report.md")).read()
     for row in ("peak speed, face centre", "farthest coal from the face", "cavity", "loosened seam coal",
                 "gas released into the tunnel", "steepest pressure drop", "Energy budget"):

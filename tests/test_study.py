@@ -11,13 +11,12 @@ import sys
 
 def main():
     source, work = sys.argv[1], sys.argv[2]
-    study = os.path.join(source, "cases", "study.py")
     fixture = os.path.join(source, "tests", "study_fixture")
     failures = []
 
     out = os.path.join(work, "known_order")
-    done = subprocess.run([sys.executable, study, os.path.join(fixture, "study.toml"), "--out", out],
-                          capture_output=True, text=True)
+    done = subprocess.run([sys.executable, "-m", "cases.study", os.path.join(fixture, "study.toml"), "--out", out],
+                          capture_output=True, text=True, cwd=source)
     if done.returncode != 0:
         sys.exit(f"the study failed: {done.stderr}")
     with open(os.path.join(out, "study_orders.csv")) as f:
@@ -41,8 +40,8 @@ def main():
     with open(bad, "w") as f:
         f.write(f'scene = "{fixture}/scene.toml"\nprogram = "{fixture}/known_order.py"\n'
                 f'measure = "{fixture}/measure.py"\n[[knobs]]\nname = "grid_sise"\nvalues = [1, 2]\n')
-    done = subprocess.run([sys.executable, study, bad, "--out", os.path.join(work, "bad")], capture_output=True,
-                          text=True)
+    done = subprocess.run([sys.executable, "-m", "cases.study", bad, "--out", os.path.join(work, "bad")],
+                          capture_output=True, text=True, cwd=source)
     message = done.stderr.strip()
     print(f"unknown knob: exit {done.returncode}: {message}")
     if done.returncode == 0 or 'unknown knob "grid_sise"' not in message or "mpm_cell_size" not in message \

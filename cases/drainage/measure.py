@@ -3,14 +3,11 @@ half-space solution (plot.py computes it) at the run's last output: pressure
 (RMS along the seam's middle over the first 15 m, over p0) and the gas
 released through the face (relative). For cases/study.py."""
 import os
-import sys
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-from plot import DAY, MPA, similarity  # noqa: E402
-from run_output import seepage_state  # noqa: E402
+from ..run_output import seepage_state
+from .plot import DAY, MPA, similarity
 
 # The scene's values (drainage.toml).
 LAMBDA = 0.1 / (MPA ** 2 * DAY)

@@ -1,7 +1,6 @@
-#!/usr/bin/python3
 """Figures of the drainage case against the self-similar half-space solution.
 
-usage: plot.py RESULTS_DIR SCENE   (writes RESULTS_DIR/drainage_*.png)
+usage: python3 -m cases.drainage.plot RESULTS_DIR SCENE   (writes RESULTS_DIR/drainage_*.png)
 
 The similarity solution P = P0 f(x / sqrt(D0 t)) of model-notes section 1 is
 computed here by ODE shooting, independently of the C++ code.

@@ -2,13 +2,9 @@
 (Abousleiman et al. 1996) at the run's last output: pore pressure (RMS over the
 seepage nodes, over p0) and the settlement of the top particles (relative,
 against the plate's). For cases/study.py."""
-import os
-import sys
-
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-from run_output import particle_state, seepage_state  # noqa: E402
+from ..run_output import particle_state, seepage_state
 
 # The scene's values (mandel.toml's header): quarter a x b, force F per metre
 # of depth on the quarter's plate.

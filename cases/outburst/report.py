@@ -1,7 +1,6 @@
-#!/usr/bin/python3
 """Figures and report of the outburst case, beside the paper's (section 4.2).
 
-usage: report.py RESULTS_DIR [--face X] [--tunnel-floor Y] [--tunnel-roof Y]
+usage: python3 -m cases.outburst.report RESULTS_DIR [--face X] [--tunnel-floor Y] [--tunnel-roof Y]
 writes RESULTS_DIR/fig3_pressure.png ... fig9_displacement.png and
 RESULTS_DIR/report.md.
 

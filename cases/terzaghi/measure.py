@@ -1,13 +1,9 @@
 """Errors of a Terzaghi run (terzaghi.toml) against the analytic series, at the
 run's last output: pore pressure (RMS over the seepage nodes, over p0) and the
 settlement of the top particles (relative). For cases/study.py."""
-import os
-import sys
-
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-from run_output import particle_state, seepage_state  # noqa: E402
+from ..run_output import particle_state, seepage_state
 
 # The scene's values (terzaghi.toml's header).
 E, NU, Q, S, MOBILITY, ALPHA, H = 1e7, 0.25, 1e4, 1e-7, 1.833e-10 / 1e-3, 1.0, 1.0

@@ -1,9 +1,8 @@
-#!/usr/bin/python3
 """The stability map of the poroelastic window schemes: predicted by
 coupler/stability.hpp (through build/coupler/coupling-stability) and measured
 by a sweep of Terzaghi runs, on one figure.
 
-usage: stability_map.py [--out DIR] [--build build] [--jobs N]
+usage: python3 -m cases.terzaghi.stability_map [--out DIR] [--build build] [--jobs N]
 
 For two Biot coefficients and four schemes (implicit with the pressure ramp,
 implicit with the end pressure and the fixed-stress split, explicit with the
@@ -23,14 +22,13 @@ import concurrent.futures
 import csv
 import os
 import subprocess
-import sys
 import tempfile
 
 import numpy as np
 
+from ..runs import run_one
+
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.dirname(HERE))
-from study import run_one  # noqa: E402
 
 SCENE = os.path.join(HERE, "terzaghi.toml")
 # The scene's column (terzaghi.toml): constrained modulus, mobility, seepage cell.
