@@ -45,13 +45,13 @@ import importlib.util
 import itertools
 import math
 import os
-import re
 import subprocess
 import sys
 import tomllib
 
 import numpy as np
 
+from . import units
 from .runs import REFUSED, run_one, write_rows
 
 
@@ -76,9 +76,6 @@ KNOBS = {
     "coupling_tolerance": ("coupling.tolerance", "sub-iteration tolerance"),
 }
 
-UNITS = {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "s": 1.0, "ms": 1e-3, "min": 60.0, "h": 3600.0, "d": 86400.0}
-
-
 def numeric(value):
     """The number a knob value stands for (the product, for cells [nx, ny]); None if categorical."""
     if isinstance(value, bool):
@@ -88,24 +85,18 @@ def numeric(value):
     if isinstance(value, list) and value and all(isinstance(v, (int, float)) for v in value):
         return float(np.prod(value))
     if isinstance(value, str):
-        m = re.fullmatch(r"\s*([0-9.eE+-]+)\s*([a-z]*)\s*", value)
-        if m and (not m.group(2) or m.group(2) in UNITS):
-            try:
-                return float(m.group(1)) * UNITS.get(m.group(2), 1.0)
-            except ValueError:
-                return None
+        try:
+            return float(units.si(value))
+        except ValueError:
+            return None
     return None
 
 
 def short(value):
     """A knob value as a person would write it (1/3 m, not 0.3333333333333333 m)."""
-    if isinstance(value, str):
-        m = re.fullmatch(r"\s*([0-9.eE+-]+)\s*([a-z]*)\s*", value)
-        if m:
-            try:
-                return f"{float(m.group(1)):.3g} {m.group(2)}".strip()
-            except ValueError:
-                pass
+    parts = units.split(value) if isinstance(value, str) else None
+    if parts:
+        return f"{parts[0]:.3g} {parts[1]}".strip()
     return str(value)
 
 

@@ -16,6 +16,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
+from ..units import value
+
 MPA = 1e6
 DAY = 86400.0
 
@@ -52,22 +54,15 @@ def similarity(face_ratio, z_max=10.0, dz=1e-3):
     return z, shoot(slope, keep=True), slope
 
 
-def quantity(text, unit):
-    value, given = text.split(maxsplit=1)
-    factors = {"MPa": MPA, "m2/(MPa2 d)": 1 / (MPA ** 2 * DAY), "MPa^-0.5": MPA ** -0.5}
-    assert given == unit, f"expected {unit}, got {given}"
-    return float(value) * factors[unit]
-
-
 def main(results, scene_file):
     with open(scene_file, "rb") as f:
         scene = tomllib.load(f)
     region = scene["seepage"]["regions"][0]
-    lam = quantity(region["lambda"], "m2/(MPa2 d)")
-    a = quantity(region["gas_content_coefficient"], "MPa^-0.5")
-    p0 = quantity(region["initial_pressure"], "MPa")
-    pf = quantity(scene["seepage"]["boundaries"][0]["value"], "MPa")
-    height = float(scene["seepage"]["mesh"]["size"][1].split()[0])
+    lam = value(region["lambda"], "m2/(Pa2 s)")
+    a = value(region["gas_content_coefficient"], "Pa^-0.5")
+    p0 = value(region["initial_pressure"], "Pa")
+    pf = value(scene["seepage"]["boundaries"][0]["value"], "Pa")
+    height = value(scene["seepage"]["mesh"]["size"][1], "m")
     P0 = p0 ** 2
     d0 = 4 * lam * P0 ** 0.75 / a
     z, f, slope = similarity((pf / p0) ** 2)
