@@ -1,24 +1,23 @@
 """The outburst's headline numbers from a run's output: what its sensitivity
 study, its ensembles and its accuracy study (measure.py) compare."""
-from .report import MPA, Run, axis_row, steepest_drop
-
-FACE = 25.0
-TUNNEL_AXIS = 4.5  # between the floor (3 m) and the roof (6 m)
+from .report import MPA, Run, axis_row, steepest_drop, tunnel
 
 
 def headline(directory):
     run = Run(directory)
+    where = tunnel(run.scene)
+    face, axis = where["face"], 0.5 * (where["floor"] + where["roof"])
     tr = run.tracers
     speed = {k: tr["speed_m_per_s"][tr["tracer"] == k].max() for k in range(3)}
     last = run.particles(-1)
     x, damage = last["points"], last["damage"].ravel()
-    ejected = x[:, 0] < FACE
+    ejected = x[:, 0] < face
     # The steepest pressure drop on the tunnel's axis at the first output and the last.
-    row = axis_row(run.nodes, FACE, TUNNEL_AXIS)
-    drops = [steepest_drop(run.pressure(k)[row] / MPA, run.nodes[row, 0] - FACE)[0] for k in (1, -1)]
+    row = axis_row(run.nodes, face, axis)
+    drops = [steepest_drop(run.pressure(k)[row] / MPA, run.nodes[row, 0] - face)[0] for k in (1, -1)]
     return {
         "centre_m_per_s": speed[1], "top_m_per_s": speed[0], "bottom_m_per_s": speed[2],
-        "farthest_m": FACE - x[:, 0].min() if ejected.any() else 0.0,
+        "farthest_m": face - x[:, 0].min() if ejected.any() else 0.0,
         "ejected_fraction": ejected.mean(),
         "fully_damaged_fraction": (damage >= 0.99).mean(),
         "gas_released_m3_per_m": run.coupling["gas_released"][-1],
