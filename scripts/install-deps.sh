@@ -17,8 +17,8 @@ packages=(
   # seepage mesh, meshed from seam.geo by its sensitivity study
   python3-tomlkit gmsh
   # the ensembles' confidence intervals (Student t); the scenes' units read
-  # in Python (cases/units.py)
-  python3-scipy python3-pint
+  # in Python (cases/units.py); the Python tests (tests/python)
+  python3-scipy python3-pint python3-pytest
 )
 
 missing=()
