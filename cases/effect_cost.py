@@ -1,8 +1,7 @@
-#!/usr/bin/python3
 """What each effect a scene names costs in wall time: the scene with every
 effect on, then with each removed in turn.
 
-usage: effect_cost.py SCENE [--set KEY=VALUE ...] [--repeats 2] [--out DIR] [--build build]
+usage: python3 -m cases.effect_cost SCENE [--set KEY=VALUE ...] [--repeats 2] [--out DIR] [--build build]
 
 Effects: seepage (the gas: the scene then runs on mpm-solid alone), damage
 (elastic_damage -> drucker_prager with the same cohesion and friction),
@@ -21,8 +20,7 @@ import sys
 
 import tomlkit
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from study import run_one  # noqa: E402
+from .runs import run_one
 
 PROGRAMS = {("mpm",): ("mpm_solid", "mpm-solid"), ("seepage",): ("seepage_fe", "seepage-fe"),
             ("mpm", "seepage"): ("coupler", "outburst")}

@@ -1,4 +1,4 @@
-"""The measure cases/study.py uses when a study names none: quantities any run
+"""The measure cases.study uses when a study names none: quantities any run
 has, compared with the reference run's. Seepage: the mean and largest gas
 pressure at the last output; MPM: the particles' mean and largest
 displacement at the last output."""
@@ -7,7 +7,7 @@ import os
 
 import numpy as np
 
-from run_output import particle_state, seepage_state
+from .run_output import particle_state, seepage_state
 
 
 def quantities(run_dir):

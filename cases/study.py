@@ -1,8 +1,7 @@
-#!/usr/bin/python3
 """Accuracy against wall time for one scene: sweep solver knobs, measure each
 run's error, and show which knob buys accuracy cheapest.
 
-usage: study.py STUDY.toml [--out DIR] [--jobs N] [--threads T] [--build build] [--check]
+usage: python3 -m cases.study STUDY.toml [--out DIR] [--jobs N] [--threads T] [--build build] [--check]
 
 STUDY.toml names the scene, the program, a measure module and the knobs:
 
@@ -41,17 +40,19 @@ log value and against log wall time, with R^2 of the fit.
 import argparse
 import concurrent.futures
 import csv
+import importlib
 import importlib.util
 import itertools
 import math
 import os
-import re
 import subprocess
 import sys
-import time
 import tomllib
 
 import numpy as np
+
+from . import units
+from .runs import REFUSED, run_one, write_rows
 
 
 class StudyError(Exception):
@@ -75,9 +76,6 @@ KNOBS = {
     "coupling_tolerance": ("coupling.tolerance", "sub-iteration tolerance"),
 }
 
-UNITS = {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "s": 1.0, "ms": 1e-3, "min": 60.0, "h": 3600.0, "d": 86400.0}
-
-
 def numeric(value):
     """The number a knob value stands for (the product, for cells [nx, ny]); None if categorical."""
     if isinstance(value, bool):
@@ -87,24 +85,18 @@ def numeric(value):
     if isinstance(value, list) and value and all(isinstance(v, (int, float)) for v in value):
         return float(np.prod(value))
     if isinstance(value, str):
-        m = re.fullmatch(r"\s*([0-9.eE+-]+)\s*([a-z]*)\s*", value)
-        if m and (not m.group(2) or m.group(2) in UNITS):
-            try:
-                return float(m.group(1)) * UNITS.get(m.group(2), 1.0)
-            except ValueError:
-                return None
+        try:
+            return float(units.si(value))
+        except ValueError:
+            return None
     return None
 
 
 def short(value):
     """A knob value as a person would write it (1/3 m, not 0.3333333333333333 m)."""
-    if isinstance(value, str):
-        m = re.fullmatch(r"\s*([0-9.eE+-]+)\s*([a-z]*)\s*", value)
-        if m:
-            try:
-                return f"{float(m.group(1)):.3g} {m.group(2)}".strip()
-            except ValueError:
-                pass
+    parts = units.split(value) if isinstance(value, str) else None
+    if parts:
+        return f"{parts[0]:.3g} {parts[1]}".strip()
     return str(value)
 
 
@@ -161,6 +153,25 @@ class Knob:
         return [f"{self.key}={toml_value(value)}"]
 
 
+CASES = os.path.dirname(os.path.abspath(__file__))
+
+
+def load_measure(path):
+    """A measure module from its file. One inside this package is imported by
+    its module name, so that its package imports resolve; one elsewhere (a
+    user's own, a test's) is loaded from its file alone."""
+    path = os.path.abspath(path)
+    if os.path.commonpath([path, CASES]) == CASES:
+        inner = os.path.splitext(os.path.relpath(path, CASES))[0]
+        return importlib.import_module(".".join([__package__] + inner.split(os.sep)))
+    module_spec = importlib.util.spec_from_file_location(os.path.splitext(os.path.basename(path))[0], path)
+    if module_spec is None:
+        raise StudyError(f"measure: {path} is not a Python module")
+    measure = importlib.util.module_from_spec(module_spec)
+    module_spec.loader.exec_module(measure)
+    return measure
+
+
 def load_study(path):
     try:
         with open(path, "rb") as f:
@@ -186,14 +197,10 @@ def load_study(path):
     for name in spec_ref:
         if name not in names:
             raise StudyError(f"{path}: reference.{name} is not one of the knobs ({', '.join(sorted(names))})")
-    measure_path = os.path.join(here, spec["measure"]) if "measure" in spec else \
-        os.path.join(os.path.dirname(os.path.abspath(__file__)), "generic_measure.py")
-    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))  # run_output for the measures
-    module_spec = importlib.util.spec_from_file_location("measure", measure_path)
-    if module_spec is None or not os.path.exists(measure_path):
+    measure_path = os.path.join(here, spec.get("measure", os.path.join(CASES, "generic_measure.py")))
+    if not os.path.isfile(measure_path):
         raise StudyError(f"{path}: measure: no module {measure_path}")
-    measure = importlib.util.module_from_spec(module_spec)
-    module_spec.loader.exec_module(measure)
+    measure = load_measure(measure_path)
     if not hasattr(measure, "errors") and not hasattr(measure, "quantities"):
         raise StudyError(f"{measure_path}: defines neither errors(run_dir) nor quantities(run_dir)")
     if not hasattr(measure, "errors") and not spec_ref:
@@ -213,41 +220,6 @@ def program_path(program, build, study_dir):
     if program not in where:
         raise StudyError(f"program \"{program}\": expected seepage-fe, mpm-solid, outburst or a path")
     return os.path.join(build, where[program], program)
-
-
-# The programs' exit code for a valid scene refused because what it asks for
-# cannot work in its regime (common/program.hpp).
-REFUSED = 4
-
-
-def write_rows(path, rows):
-    """Rows of dicts to a CSV whose columns are every key, in the order first met."""
-    fields = []
-    for r in rows:
-        fields += [k for k in r if k not in fields]
-    with open(path, "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=fields)
-        w.writeheader()
-        w.writerows(rows)
-
-
-def run_one(program, scene, overrides, directory, threads):
-    """Runs a program on a scene with overrides; its wall time and, if it failed, its last message."""
-    # Studies rerun into their folders: the earlier run's files are replaced.
-    command = [program, scene, "-q", "-o", directory, "--overwrite"]
-    for o in overrides:
-        command += ["--set", o]
-    env = dict(os.environ, OMP_NUM_THREADS=str(threads))
-    start = time.monotonic()
-    done = subprocess.run(command, capture_output=True, text=True, env=env)
-    wall = time.monotonic() - start
-    note = ""
-    if done.returncode != 0:
-        lines = (done.stderr or done.stdout).strip().splitlines()
-        note = lines[-1] if lines else f"exit code {done.returncode}"
-        if done.returncode == REFUSED:
-            note = "refused: " + note.split("] ")[-1]
-    return wall, note
 
 
 def fit(x, y):
@@ -293,7 +265,7 @@ def pareto(rows):
     return sorted(front, key=lambda i: rows[i]["wall_s"])
 
 
-def main():
+def parse_args():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("study")
     ap.add_argument("--out", help="output folder (default: results/study_<study folder name>)")
@@ -301,62 +273,61 @@ def main():
     ap.add_argument("--threads", type=int, default=1, help="OpenMP threads per run (default 1)")
     ap.add_argument("--build", default="build", help="the build folder holding the programs")
     ap.add_argument("--check", action="store_true", help="validate the study and every run's scene, run nothing")
-    args = ap.parse_args()
-    try:
-        study = load_study(args.study)
-        program = program_path(study["program"], args.build, os.path.dirname(os.path.abspath(args.study)))
-        if not os.access(program, os.X_OK):
-            raise StudyError(f"program {program} not found: build first, or pass --build")
-    except StudyError as e:
-        sys.exit(f"study: {e}")
+    return ap.parse_args()
+
+
+def share_cores(jobs, threads):
+    """Runs side by side and threads per run, jobs x threads within the cores."""
     cores = os.cpu_count() or 1
-    threads = max(1, min(args.threads, cores))
-    jobs = args.jobs or max(1, cores // threads)
+    threads = max(1, min(threads, cores))
+    jobs = jobs or max(1, cores // threads)
     if jobs * threads > cores:
-        sys.exit(f"study: {jobs} jobs x {threads} threads would oversubscribe {cores} cores")
-    name = os.path.basename(os.path.dirname(os.path.abspath(args.study)))
-    out = args.out or os.path.join("results", f"study_{name}")
+        raise StudyError(f"{jobs} jobs x {threads} threads would oversubscribe {cores} cores")
+    return jobs, threads
+
+
+def plan(study):
+    """The runs as (tag, setting, overrides): each knob alone around the scene's
+    values, or every combination; the reference run first."""
     knobs = study["knobs"]
-
-    # The runs: each knob alone around the scene's values, or every combination.
-    runs = []
     if study["combine"]:
-        for combo in itertools.product(*[k.values for k in knobs]):
-            runs.append(dict(zip([k.label for k in knobs], combo)))
+        labels = [k.label for k in knobs]
+        settings = [dict(zip(labels, combo)) for combo in itertools.product(*[k.values for k in knobs])]
     else:
-        for k in knobs:
-            for v in k.values:
-                runs.append({k.label: v})
-    try:
-        def overrides(setting):
-            o = list(study["set"])
-            for k in knobs:
-                if k.label in setting:
-                    o += k.overrides(setting[k.label])
-            return o
-        planned = [(f"run_{i:03d}", s, overrides(s)) for i, s in enumerate(runs)]
-        if study["reference"]:
-            planned.insert(0, ("reference", study["reference"], overrides(study["reference"])))
-    except StudyError as e:
-        sys.exit(f"study: {e}")
+        settings = [{k.label: v} for k in knobs for v in k.values]
 
-    if args.check:
-        refused = 0
-        for tag, setting, o in planned:
-            command = [program, study["scene"], "--check"] + [x for v in o for x in ("--set", v)]
-            done = subprocess.run(command, capture_output=True, text=True)
-            lines = (done.stderr or done.stdout).strip().splitlines()
-            # Exit code 4: a valid setting the program refuses as unstable, a
-            # result of the sweep (the reference must run, though).
-            if done.returncode == REFUSED and tag != "reference":
-                refused += 1
-                print(f"study: {tag} {setting}: refused: {lines[-1] if lines else ''}")
-            elif done.returncode != 0:
-                sys.exit(f"study: {args.study}: {tag} {setting}: {lines[-1] if lines else 'invalid'}")
-        print(f"study: {args.study}: {len(planned)} runs, every scene valid"
-              + (f" ({refused} refused as unstable)" if refused else ""))
-        return
-    os.makedirs(out, exist_ok=True)
+    def overrides(setting):
+        o = list(study["set"])
+        for k in knobs:
+            if k.label in setting:
+                o += k.overrides(setting[k.label])
+        return o
+    planned = [(f"run_{i:03d}", s, overrides(s)) for i, s in enumerate(settings)]
+    if study["reference"]:
+        planned.insert(0, ("reference", study["reference"], overrides(study["reference"])))
+    return planned
+
+
+def check(program, study, planned, name):
+    """Validates every run's scene with the program's --check; prints what it refuses."""
+    refused = 0
+    for tag, setting, o in planned:
+        command = [program, study["scene"], "--check"] + [x for v in o for x in ("--set", v)]
+        done = subprocess.run(command, capture_output=True, text=True)
+        lines = (done.stderr or done.stdout).strip().splitlines()
+        # Exit code 4: a valid setting the program refuses as unstable, a
+        # result of the sweep (the reference must run, though).
+        if done.returncode == REFUSED and tag != "reference":
+            refused += 1
+            print(f"study: {tag} {setting}: refused: {lines[-1] if lines else ''}")
+        elif done.returncode != 0:
+            raise StudyError(f"{name}: {tag} {setting}: {lines[-1] if lines else 'invalid'}")
+    print(f"study: {name}: {len(planned)} runs, every scene valid"
+          + (f" ({refused} refused as unstable)" if refused else ""))
+
+
+def run_all(program, study, planned, out, jobs, threads):
+    """Runs the plan side by side; each tag's wall time and failure note."""
     print(f"study: {len(planned)} runs of {study['scene']}, {jobs} at a time with {threads} thread(s) each",
           flush=True)
     results = {}
@@ -368,13 +339,18 @@ def main():
             wall, note = f.result()
             results[tag] = (wall, note)
             print(f"  {tag} {setting}: {wall:.1f} s {note}", flush=True)
+    return results
 
-    measure = study["measure"]
+
+def measure_runs(study, planned, results, out):
+    """A row per run (the reference aside): its knob values, wall time, error and
+    each named error, and its sub-iterations if coupled."""
+    measure, knobs = study["measure"], study["knobs"]
     reference = None
     if study["reference"]:
         wall, note = results["reference"]
         if note:
-            sys.exit(f"study: the reference run failed: {note}")
+            raise StudyError(f"the reference run failed: {note}")
         reference = measure.quantities(os.path.join(out, "reference"))
     rows = []
     for tag, setting, _ in planned:
@@ -392,24 +368,26 @@ def main():
                     q = measure.quantities(directory)
                     errors = {k: difference(q[k], v) for k, v in reference.items()}
             except StudyError as e:
-                sys.exit(f"study: {tag}: {e}")
+                raise StudyError(f"{tag}: {e}") from e
         row = {"run": tag, **{k.label: setting.get(k.label, "") for k in knobs}, "wall_s": wall,
                "error": max(errors.values()) if errors else float("nan"), "note": note}
         if iterations is not None:
             row["sub_iterations"] = iterations
         row.update({f"error_{k}": v for k, v in errors.items()})
         rows.append(row)
-
     front = set(pareto(rows))
     for i, r in enumerate(rows):
         r["pareto"] = i in front
-    write_rows(os.path.join(out, "study.csv"), rows)
+    return rows
 
-    # Each numeric knob's order: alone, or (combined) for each setting of the others.
-    orders = []
+
+def orders(knobs, rows, combine):
+    """Each numeric knob's order: alone, or (combined) for each setting of the
+    others. (label, (p, R^2) in value, (q, R^2) in wall time or None)."""
+    found = []
     for k in knobs:
         others = [o for o in knobs if o is not k]
-        if study["combine"]:
+        if combine:
             groups = {}
             for r in rows:
                 groups.setdefault(tuple(short(r[o.label]) for o in others), []).append(r)
@@ -423,8 +401,13 @@ def main():
             by_time = fit([r["wall_s"] for r in mine], [r["error"] for r in mine])
             label = k.label + (" (" + ", ".join(f"{o.label} {v}" for o, v in zip(others, key)) + ")" if key else "")
             if by_value:
-                orders.append((label, by_value, by_time))
+                found.append((label, by_value, by_time))
+    return found
 
+
+def table(study, rows, found, jobs, threads):
+    """study.md's lines: a row per run, then the orders."""
+    knobs, measure = study["knobs"], study["measure"]
     coupled = any("sub_iterations" in r for r in rows)
     lines = [f"# Study: `{os.path.relpath(study['scene'])}`", "",
              f"Error: {'against the analytic solution' if hasattr(measure, 'errors') else 'relative to the reference run'} "
@@ -440,36 +423,40 @@ def main():
             cells.append(f"{r['sub_iterations']:.2f}" if "sub_iterations" in r else "-")
         error = f"{r['error']:.3e}" if math.isfinite(r["error"]) else r["note"][:60]
         lines.append("| " + " | ".join(cells) + f" | {r['wall_s']:.2f} | {error} | {'*' if r['pareto'] else ''} |")
-    if orders:
+    if found:
         lines += ["", "| knob | error ~ value^p: p (R^2) | error ~ wall^q: q (R^2) |", "|---|---|---|"]
-        for label, (p, r2), by_time in orders:
+        for label, (p, r2), by_time in found:
             t = f"{by_time[0]:.2f} ({by_time[1]:.3f})" if by_time else "-"
             lines.append(f"| {label} | {p:.2f} ({r2:.3f}) | {t} |")
-    with open(os.path.join(out, "study.md"), "w") as f:
-        f.write("\n".join(lines) + "\n")
-    with open(os.path.join(out, "study_orders.csv"), "w", newline="") as f:
+    return lines
+
+
+def write_orders(path, found):
+    with open(path, "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(["knob", "order_in_value", "r2_value", "order_in_wall_time", "r2_wall_time"])
-        for label, (p, r2), by_time in orders:
+        for label, (p, r2), by_time in found:
             w.writerow([label, p, r2, by_time[0] if by_time else "", by_time[1] if by_time else ""])
-    print("\n".join(lines))
 
+
+def plot(study, rows, path):
+    """Error against wall time, each knob's runs (or every run, combined) and the Pareto front."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(6.5, 4.5))
-    for k in knobs:
-        mine = [r for r in rows if r[k.label] != "" and math.isfinite(r["error"])]
-        if not study["combine"]:
+    if study["combine"]:
+        ok = [r for r in rows if math.isfinite(r["error"])]
+        ax.plot([r["wall_s"] for r in ok], [r["error"] for r in ok], "o", label="runs")
+    else:
+        for k in study["knobs"]:
+            mine = [r for r in rows if r[k.label] != "" and math.isfinite(r["error"])]
             ax.plot([r["wall_s"] for r in mine], [r["error"] for r in mine], "o-", label=k.label)
             for r in mine:
                 ax.annotate(short(r[k.label]), (r["wall_s"], r["error"]), fontsize=7, xytext=(3, 3),
                             textcoords="offset points")
-    if study["combine"]:
-        ok = [r for r in rows if math.isfinite(r["error"])]
-        ax.plot([r["wall_s"] for r in ok], [r["error"] for r in ok], "o", label="runs")
-    f_rows = [rows[i] for i in sorted(front, key=lambda i: rows[i]["wall_s"])]
-    ax.step([r["wall_s"] for r in f_rows], [r["error"] for r in f_rows], "k--", where="post", lw=1,
+    front = sorted((r for r in rows if r["pareto"]), key=lambda r: r["wall_s"])
+    ax.step([r["wall_s"] for r in front], [r["error"] for r in front], "k--", where="post", lw=1,
             label="Pareto front")
     ax.set_xscale("log")
     ax.set_yscale("log")
@@ -479,7 +466,36 @@ def main():
     ax.legend(fontsize=8)
     ax.grid(True, which="both", alpha=0.3)
     fig.tight_layout()
-    fig.savefig(os.path.join(out, "study.png"), dpi=120)
+    fig.savefig(path, dpi=120)
+
+
+def main():
+    args = parse_args()
+    try:
+        study = load_study(args.study)
+        program = program_path(study["program"], args.build, os.path.dirname(os.path.abspath(args.study)))
+        if not os.access(program, os.X_OK):
+            raise StudyError(f"program {program} not found: build first, or pass --build")
+        jobs, threads = share_cores(args.jobs, args.threads)
+        planned = plan(study)
+        if args.check:
+            check(program, study, planned, args.study)
+            return
+        name = os.path.basename(os.path.dirname(os.path.abspath(args.study)))
+        out = args.out or os.path.join("results", f"study_{name}")
+        os.makedirs(out, exist_ok=True)
+        results = run_all(program, study, planned, out, jobs, threads)
+        rows = measure_runs(study, planned, results, out)
+    except StudyError as e:
+        sys.exit(f"study: {e}")
+    write_rows(os.path.join(out, "study.csv"), rows)
+    found = orders(study["knobs"], rows, study["combine"])
+    lines = table(study, rows, found, jobs, threads)
+    with open(os.path.join(out, "study.md"), "w") as f:
+        f.write("\n".join(lines) + "\n")
+    write_orders(os.path.join(out, "study_orders.csv"), found)
+    print("\n".join(lines))
+    plot(study, rows, os.path.join(out, "study.png"))
     print(f"study: {out}/study.csv, study.md, study.png")
 
 

@@ -16,8 +16,9 @@ packages=(
   # scene files edited by the studies (comments kept); the outburst's finer
   # seepage mesh, meshed from seam.geo by its sensitivity study
   python3-tomlkit gmsh
-  # the ensembles' confidence intervals (Student t)
-  python3-scipy
+  # the ensembles' confidence intervals (Student t); the scenes' units read
+  # in Python (cases/units.py); the Python tests (tests/python)
+  python3-scipy python3-pint python3-pytest
 )
 
 missing=()

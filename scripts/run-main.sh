@@ -8,7 +8,7 @@ scripts/install-deps.sh
 scripts/build.sh
 rm -rf results/outburst
 build/coupler/outburst cases/outburst/outburst.toml --output results/outburst
-/usr/bin/python3 cases/outburst/report.py results/outburst
+/usr/bin/python3 -m cases.outburst.report results/outburst
 cases/outburst/run-to-rest.sh results/outburst_to_rest
 echo "main job: results in results/outburst (the paper's first second) and results/outburst_to_rest (to rest):"
 echo "report.md, fig*.png; open particles.xdmf and seepage.xdmf in ParaView"

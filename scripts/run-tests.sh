@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Every test: install what is missing, build, run the Catch2 suite and the
-# ParaView check through CTest on all cores.
+# Every test: install what is missing, build, run the Catch2 suite, the
+# ParaView check and the Python tests (pytest) through CTest on all cores.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Check the outburst ensemble command (cases/outburst/ensemble.py) on a short
+"""Check the outburst ensemble command (cases.outburst.ensemble) on a short
 run: every member finishes and the statistics cover each headline number; the
 heterogeneous coal of a seed is the same bit for bit on two thread counts
 (two runs side by side with cores / 2 threads each, then seed 1 alone with all
@@ -17,12 +17,12 @@ import h5py
 import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-ENSEMBLE = os.path.join(HERE, "..", "cases", "outburst", "ensemble.py")
+SOURCE = os.path.dirname(HERE)
 
 
 def ensemble(program, out, seeds, jobs):
-    subprocess.run([sys.executable, ENSEMBLE, "--outburst", program, "--out", out, "--seeds", str(seeds),
-                    "--jobs", str(jobs), "--end-time", "0.02 s"], check=True, stdout=subprocess.DEVNULL)
+    subprocess.run([sys.executable, "-m", "cases.outburst.ensemble", "--outburst", program, "--out", out, "--seeds", str(seeds),
+                    "--jobs", str(jobs), "--end-time", "0.02 s"], check=True, stdout=subprocess.DEVNULL, cwd=SOURCE)
 
 
 def coal(run_dir):

@@ -1,11 +1,10 @@
-#!/usr/bin/python3
 """An ensemble of the outburst case over heterogeneous coal: one run per seed of
 the Weibull draw, side by side, and each headline number's mean, spread and
 95 % confidence interval.
 
-usage: ensemble.py [--outburst build/coupler/outburst] [--out results/outburst_ensemble]
-                   [--seeds 8] [--homogeneity 3] [--end-time "1 s"] [--jobs J]
-                   [--set KEY=VALUE ...] [--sweep KEY --values V1 V2 ...] [--resume]
+usage: python3 -m cases.outburst.ensemble [--outburst build/coupler/outburst] [--out results/outburst_ensemble]
+                                          [--seeds 8] [--homogeneity 3] [--end-time "1 s"] [--jobs J]
+                                          [--set KEY=VALUE ...] [--sweep KEY --values V1 V2 ...] [--resume]
 
 Each run is the shipped case with mpm.materials[0].heterogeneity = {
 homogeneity_index = M, seed = k} for k = 1..N (mpm_solid/README.md,
@@ -30,11 +29,10 @@ import sys
 import numpy as np
 from scipy import stats
 
+from ..runs import run_one, write_rows
+from .headline import headline
+
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.dirname(HERE))
-sys.path.insert(0, HERE)
-from sensitivity import headline  # noqa: E402
-from study import run_one, write_rows  # noqa: E402
 
 # The headline numbers the statistics cover, with their labels.
 QUANTITIES = [

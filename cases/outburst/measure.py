@@ -1,12 +1,8 @@
-"""The outburst's headline quantities for cases/study.py (no analytic
+"""The outburst's headline quantities for cases.study (no analytic
 solution: the study compares them with a much finer reference run): the peak
 ejection speed at the face centre, the farthest coal from the face, the gas
 released into the tunnel and the fully damaged share of the coal."""
-import os
-import sys
-
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from sensitivity import headline  # noqa: E402
+from .headline import headline
 
 
 def quantities(run_dir):

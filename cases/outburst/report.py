@@ -1,14 +1,15 @@
-#!/usr/bin/python3
 """Figures and report of the outburst case, beside the paper's (section 4.2).
 
-usage: report.py RESULTS_DIR [--face X] [--tunnel-floor Y] [--tunnel-roof Y]
+usage: python3 -m cases.outburst.report RESULTS_DIR [--face X] [--tunnel-floor Y] [--tunnel-roof Y] [--top Y]
 writes RESULTS_DIR/fig3_pressure.png ... fig9_displacement.png and
 RESULTS_DIR/report.md.
 
 Snapshots are the paper's "steps": the run's output times, five of them picked
 evenly over the run (the paper never states its time step, model-notes
 section 5). Everything is read from the run's own files: particles_*.h5,
-seepage_*.h5, tracers.csv, mpm_history.csv, coupling.csv.
+seepage_*.h5, tracers.csv, mpm_history.csv, coupling.csv, and the geometry
+from the scene they record (the face support's box, the coal's top), unless
+the options give it.
 """
 import argparse
 import glob
@@ -21,6 +22,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 from matplotlib.collections import PolyCollection
 import numpy as np
+
+from ..run_output import scene
+from ..units import value
 
 MPA = 1e6
 # The paper's figures (section 4.2) for the table.
@@ -39,6 +43,22 @@ def five(n):
     return sorted(set(int(round(i)) for i in np.linspace(1, n - 1, 5)))
 
 
+def tunnel(s):
+    """The excavation face's x, the tunnel's floor and roof and the coal's top
+    [m] in an outburst scene: the face is the support removed at t = 0."""
+    support = [o for o in s["mpm"].get("obstacles", []) if o.get("support", False)]
+    if len(support) != 1:
+        raise ValueError(f"the scene has {len(support)} face supports (obstacles with support = true), not one")
+    (x0, y0), (x1, y1) = ([value(c, "m") for c in support[0][k]] for k in ("box_min", "box_max"))
+    top = max(value(b["box_max"][1], "m") for b in s["mpm"]["bodies"])
+    return {"face": x1, "floor": y0, "roof": y1, "top": top}
+
+
+def initial_pressure(s):
+    """The largest gas pressure at t = 0 [Pa], the pressure figure's scale."""
+    return max(value(r["initial_pressure"], "Pa") for r in s["seepage"]["regions"])
+
+
 class Run:
     def __init__(self, d):
         self.dir = d
@@ -52,6 +72,7 @@ class Run:
         self.tracers = np.genfromtxt(os.path.join(d, "tracers.csv"), delimiter=",", names=True)
         self.history = np.genfromtxt(os.path.join(d, "mpm_history.csv"), delimiter=",", names=True)
         self.coupling = np.genfromtxt(os.path.join(d, "coupling.csv"), delimiter=",", names=True)
+        self.scene = scene(d)
 
     def particles(self, k):
         with h5py.File(self.particle_files[k]) as f:
@@ -96,12 +117,19 @@ def particle_figure(run, picks, field, label, path, geometry, cmap="viridis", vm
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("results")
-    ap.add_argument("--face", type=float, default=25.0, help="x of the excavation face [m]")
-    ap.add_argument("--tunnel-floor", type=float, default=3.0)
-    ap.add_argument("--tunnel-roof", type=float, default=6.0)
-    ap.add_argument("--top", type=float, default=9.0, help="height of the model [m]")
+    ap.add_argument("--face", type=float, help="x of the excavation face [m] (default: the scene's)")
+    ap.add_argument("--tunnel-floor", type=float, help="[m] (default: the scene's)")
+    ap.add_argument("--tunnel-roof", type=float, help="[m] (default: the scene's)")
+    ap.add_argument("--top", type=float, help="height of the model [m] (default: the scene's)")
     args = ap.parse_args()
     run = Run(args.results)
+    given = {"face": args.face, "floor": args.tunnel_floor, "roof": args.tunnel_roof, "top": args.top}
+    if None in given.values():
+        try:
+            given = tunnel(run.scene) | {k: v for k, v in given.items() if v is not None}
+        except ValueError as e:
+            ap.error(f"{e}: give --face, --tunnel-floor, --tunnel-roof and --top")
+    args.face, args.tunnel_floor, args.tunnel_roof, args.top = (given[k] for k in ("face", "floor", "roof", "top"))
     face, floor, roof, top = args.face, args.tunnel_floor, args.tunnel_roof, args.top
     # The tunnel runs from the model's left edge to the face.
     left, width = float(run.nodes[:, 0].min()), float(run.nodes[:, 0].max())
@@ -116,7 +144,7 @@ def main():
     for ax, k in zip(axes, seep_picks):
         p = run.pressure(k) / MPA
         coll = PolyCollection(polys, array=p[run.cells].mean(axis=1), cmap="jet", edgecolors="none")
-        coll.set_clim(0, 3.0)
+        coll.set_clim(0, initial_pressure(run.scene) / MPA)
         ax.add_collection(coll)
         draw_rock(ax, *geometry[:5])
         ax.set_xlim(left, width)

@@ -1,9 +1,8 @@
-#!/usr/bin/python3
 """Sensitivity of the outburst case's headline numbers to the parameters the
 paper does not give, and to resolution.
 
-usage: sensitivity.py [--outburst build/coupler/outburst] [--out results/outburst_sensitivity]
-                      [--end-time "1 s"] [--only TEXT] [--resume]
+usage: python3 -m cases.outburst.sensitivity [--outburst build/coupler/outburst] [--out results/outburst_sensitivity]
+                                              [--end-time "1 s"] [--only TEXT] [--resume]
 writes OUT/sensitivity.md and OUT/sensitivity.csv; one run per row (one at a
 time: each uses every core), 11 minutes on 2 cores for the parameter rows;
 --only runs the rows whose label holds TEXT (--only transfer: the grid
@@ -16,16 +15,11 @@ import argparse
 import json
 import os
 import subprocess
-import sys
+
+from ..runs import run_one, write_rows
+from .headline import headline
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.dirname(HERE))
-sys.path.insert(0, HERE)
-from report import MPA, Run, axis_row, steepest_drop  # noqa: E402
-from study import run_one, write_rows  # noqa: E402
-
-FACE = 25.0
-TUNNEL_AXIS = 4.5  # between the floor (3 m) and the roof (6 m)
 
 # (label, overrides): each row changes one choice of outburst.toml.
 VARIANTS = [
@@ -63,30 +57,6 @@ def fine_mesh(out):
     subprocess.run(["gmsh", "-2", "-format", "msh41", "-setnumber", "h", str(FINE_SEEPAGE_H),
                     os.path.join(HERE, "seam.geo"), "-o", path], check=True, stdout=subprocess.DEVNULL)
     return f'seepage.mesh.file="{path}"'
-
-
-def headline(directory):
-    run = Run(directory)
-    tr = run.tracers
-    speed = {k: tr["speed_m_per_s"][tr["tracer"] == k].max() for k in range(3)}
-    last = run.particles(-1)
-    x, damage = last["points"], last["damage"].ravel()
-    ejected = x[:, 0] < FACE
-    # The steepest pressure drop on the tunnel's axis at the first output and the last.
-    row = axis_row(run.nodes, FACE, TUNNEL_AXIS)
-    drops = [steepest_drop(run.pressure(k)[row] / MPA, run.nodes[row, 0] - FACE)[0] for k in (1, -1)]
-    return {
-        "centre_m_per_s": speed[1], "top_m_per_s": speed[0], "bottom_m_per_s": speed[2],
-        "farthest_m": FACE - x[:, 0].min() if ejected.any() else 0.0,
-        "ejected_fraction": ejected.mean(),
-        "fully_damaged_fraction": (damage >= 0.99).mean(),
-        "gas_released_m3_per_m": run.coupling["gas_released"][-1],
-        "left_grid": int(run.history["removed_total"][-1]),
-        "first_drop_MPa_per_m": drops[0], "last_drop_MPa_per_m": drops[1],
-        # What the transfer and the time step took, of the gas work.
-        "transfer_share": run.history["transfer_J_per_m"][-1] / run.history["external_work_J_per_m"][-1],
-        "step_share": run.history["integration_J_per_m"][-1] / run.history["external_work_J_per_m"][-1],
-    }
 
 
 def main():

@@ -1,9 +1,8 @@
-#!/usr/bin/python3
 """The stability map of the poroelastic window schemes: predicted by
 coupler/stability.hpp (through build/coupler/coupling-stability) and measured
 by a sweep of Terzaghi runs, on one figure.
 
-usage: stability_map.py [--out DIR] [--build build] [--jobs N]
+usage: python3 -m cases.terzaghi.stability_map [--out DIR] [--build build] [--jobs N]
 
 For two Biot coefficients and four schemes (implicit with the pressure ramp,
 implicit with the end pressure and the fixed-stress split, explicit with the
@@ -23,19 +22,24 @@ import concurrent.futures
 import csv
 import os
 import subprocess
-import sys
 import tempfile
+import tomllib
 
 import numpy as np
 
+from ..runs import run_one
+from ..units import value
+from .measure import Column
+
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.dirname(HERE))
-from study import run_one  # noqa: E402
 
 SCENE = os.path.join(HERE, "terzaghi.toml")
-# The scene's column (terzaghi.toml): constrained modulus, mobility, seepage cell.
-E, NU, MOBILITY, CELL = 10e6, 0.25, 1.833e-10 / 1e-3, 0.05
-M = E * (1 - NU) / ((1 + NU) * (1 - 2 * NU))
+with open(SCENE, "rb") as _f:
+    _scene = tomllib.load(_f)
+# The scene's column: constrained modulus, mobility, seepage cell height.
+_column = Column(_scene)
+M, MOBILITY = _column.modulus, _column.mobility
+CELL = value(_scene["seepage"]["mesh"]["size"][1], "m") / _scene["seepage"]["mesh"]["cells"][1]
 SCHEMES = {  # label: overrides
     "implicit, ramp": ['coupling.scheme="implicit"', 'coupling.window_pressure="ramp"'],
     "implicit, end + fixed stress": ['coupling.scheme="implicit"', 'coupling.window_pressure="end"',

@@ -1,0 +1,1 @@
+"""The bar stopped at one end: its study measure."""

@@ -1,0 +1,1 @@
+"""Gas drainage through a face: its similarity solution, study measure and figures."""

@@ -1,0 +1,1 @@
+"""Mandel's problem: its study measure."""

@@ -1,0 +1,1 @@
+"""The paper's outburst: its report, headline numbers, sensitivity study and ensembles."""

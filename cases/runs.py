@@ -1,0 +1,40 @@
+"""Running the programs for the studies, sensitivity runs and ensembles, and
+writing their rows."""
+import csv
+import os
+import subprocess
+import time
+
+# The programs' exit code for a valid scene refused because what it asks for
+# cannot work in its regime (common/program.hpp).
+REFUSED = 4
+
+
+def run_one(program, scene, overrides, directory, threads):
+    """Runs a program on a scene with overrides; its wall time and, if it failed, its last message."""
+    # Studies rerun into their folders: the earlier run's files are replaced.
+    command = [program, scene, "-q", "-o", directory, "--overwrite"]
+    for o in overrides:
+        command += ["--set", o]
+    env = dict(os.environ, OMP_NUM_THREADS=str(threads))
+    start = time.monotonic()
+    done = subprocess.run(command, capture_output=True, text=True, env=env)
+    wall = time.monotonic() - start
+    note = ""
+    if done.returncode != 0:
+        lines = (done.stderr or done.stdout).strip().splitlines()
+        note = lines[-1] if lines else f"exit code {done.returncode}"
+        if done.returncode == REFUSED:
+            note = "refused: " + note.split("] ")[-1]
+    return wall, note
+
+
+def write_rows(path, rows):
+    """Rows of dicts to a CSV whose columns are every key, in the order first met."""
+    fields = []
+    for r in rows:
+        fields += [k for k in r if k not in fields]
+    with open(path, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=fields)
+        w.writeheader()
+        w.writerows(rows)

@@ -1,0 +1,1 @@
+"""Terzaghi's consolidation: its study measure and the window schemes' stability map."""
