@@ -28,6 +28,7 @@
 
 #include "common/checkpoint.hpp"
 #include "common/field_output.hpp"
+#include "common/interval.hpp"
 #include "common/output_folder.hpp"
 #include "common/scene.hpp"
 #include "common/stop.hpp"
@@ -99,7 +100,7 @@ class CheckpointClock {
   // True when `time` [s] has reached the next checkpoint time, which then
   // moves past it.
   bool due(double time) {
-    if (time < next_ * (1 - 1e-12)) return false;
+    if (!reached(time, next_, next_)) return false;
     while (next_ <= time * (1 + 1e-12)) next_ += interval_;
     return true;
   }

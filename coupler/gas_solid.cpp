@@ -5,6 +5,8 @@
 
 #include <fmt/format.h>
 
+#include "common/interval.hpp"
+
 namespace outburst::coupling {
 
 namespace {
@@ -257,7 +259,7 @@ void SolidParticipant::advance(double window) {
   mark_window_start();
   const double start = solver_.time(), end = start + window;
   last_window_ = {0};
-  while (solver_.time() < end - 1e-12 * window) {
+  while (!reached(solver_.time(), end, window)) {
     const double dt = std::min(fixed_time_step_ ? *fixed_time_step_ : solver_.stable_time_step(), end - solver_.time());
     // The force at the middle of the step (explicit steps are short: the
     // pressure barely changes over one).

@@ -11,6 +11,7 @@
 #include "common/output_folder.hpp"
 #include "common/program.hpp"
 #include "common/progress.hpp"
+#include "common/run_loop.hpp"
 #include "common/stop.hpp"
 #include "coupler/model.hpp"
 #include "mpm_solid/output.hpp"
@@ -105,32 +106,46 @@ int run(const RunOptions& options, scene::Document& doc) {
   WindowLog log(directory / "coupling.csv", cs.scheme.to_first, resume_run);
   seepage_out.series().list_with_others();
   solid_out.series().list_with_others();
-  const auto snapshot = [&] {
-    seepage_out.snapshot(seepage_solver);
-    solid_out.snapshot(solid);
-    output::publish({&seepage_out.series(), &solid_out.series()});
-  };
-
   const auto wall_start = std::chrono::steady_clock::now();
-  double next_output = header.output_interval;
-  long iterations = 0;
   const auto& coupler = model.coupling();
-  RestWatch rest(header.rest_fraction);
-  CheckpointClock checkpoints(header.checkpoint_interval);
-  const auto save_checkpoint = [&] {
-    checkpoint::Writer file(directory, info, checkpoint::Stage::run);
-    auto root = file.root();
-    model.save(root.group("model"));
-    seepage_out.save(root.group("seepage_output"));
-    solid_out.save(root.group("mpm_output"));
-    log.save(root.group("coupling_log"));
-    const auto run = root.group("run");
-    run.number("next_output", next_output);
-    run.count("iterations", iterations);
-    rest.save(run.group("rest"));
-    checkpoints.save(run.group("checkpoints"));
-    file.commit();
-  };
+  // One coupling window at a time, cut short at an output time.
+  struct Driver {
+    coupling::CoupledModel& model;
+    seepage::Output& seepage_out;
+    mpm::Output& solid_out;
+    WindowLog& log;
+    long iterations = 0;
+    double kinetic = 0;  // after the last window [J/m]
+
+    double time() const { return model.coupling().time(); }
+    LoopStep advance(double target) {
+      const auto& r = model.advance(target);
+      iterations += r.iterations;
+      auto& solid = model.solid();
+      auto& seepage = model.seepage();
+      solid_out.history(solid, model.solid_side().last_window());
+      seepage_out.history(seepage, r.size, model.seepage_side().last_report());
+      kinetic = solid.kinetic_energy();
+      const auto windows = model.coupling().records().size();
+      log.write(windows, r, model.seepage_side().open_cells(), seepage.balance().total_outflow(), kinetic,
+                solid.particles().size());
+      return {static_cast<long>(windows), r.size, fmt::format("sub-iterations {}", r.iterations)};
+    }
+    double kinetic_energy() const { return kinetic; }
+    void snapshot() {
+      seepage_out.snapshot(model.seepage());
+      solid_out.snapshot(model.solid());
+      output::publish({&seepage_out.series(), &solid_out.series()});
+    }
+    void save(checkpoint::Out root, checkpoint::Out run) const {
+      model.save(root.group("model"));
+      seepage_out.save(root.group("seepage_output"));
+      solid_out.save(root.group("mpm_output"));
+      log.save(root.group("coupling_log"));
+      run.count("iterations", iterations);
+    }
+  } driver{model, seepage_out, solid_out, log};
+  RunLoop loop(header, directory, info);
   if (resume_run) {
     const auto root = restart->root();
     model.load(root.group("model"));
@@ -138,55 +153,23 @@ int run(const RunOptions& options, scene::Document& doc) {
     solid_out.load(root.group("mpm_output"));
     log.load(root.group("coupling_log"));
     const auto run = root.group("run");
-    next_output = run.number("next_output");
-    iterations = run.count("iterations");
-    rest.load(run.group("rest"));
-    checkpoints.load(run.group("checkpoints"));
+    driver.iterations = run.count("iterations");
+    loop.load(run);
     spdlog::info("restarted from {} at t = {:.9g} s, window {}", restart->path().string(), coupler.time(),
                  coupler.records().size());
   } else {
-    snapshot();
+    driver.snapshot();
   }
-
-  Progress progress("outburst", coupler.time(), header.end_time, options.show_progress());
-  bool at_rest = false;
-  while (coupler.time() < header.end_time * (1 - 1e-12)) {
-    const double target = std::min(next_output, header.end_time);
-    const auto& r = model.advance(target);
-    iterations += r.iterations;
-    solid_out.history(solid, model.solid_side().last_window());
-    seepage_out.history(seepage_solver, r.size, model.seepage_side().last_report());
-    const double kinetic = solid.kinetic_energy();
-    log.write(coupler.records().size(), r, model.seepage_side().open_cells(), seepage_solver.balance().total_outflow(),
-              kinetic, solid.particles().size());
-    progress.update(static_cast<long>(coupler.records().size()), coupler.time(), r.size,
-                    fmt::format("sub-iterations {}", r.iterations));
-    const bool output_due = coupler.time() >= target * (1 - 1e-12);
-    at_rest = rest.at_rest(kinetic);
-    const bool stop = stop_requested();  // read once: a signal may come in between
-    if (output_due || at_rest) {
-      snapshot();
-      if (output_due) next_output += header.output_interval;
-    }
-    if (checkpoints.due(coupler.time()) || stop) save_checkpoint();
-    if (stop) {
-      // After the checkpoint: a restart drops this extra snapshot, and its
-      // folder ends as the uninterrupted run's would.
-      if (!output_due && !at_rest) snapshot();
-      progress.finish();
-      return report_stop(coupler.time(), directory);
-    }
-    if (at_rest) break;
-  }
-  progress.finish();
+  const RunEnd end = loop.run(driver, "outburst", options.show_progress());
+  if (end == RunEnd::stopped) return report_stop(coupler.time(), directory);
   solid_out.finish();
-  if (at_rest)
+  if (end == RunEnd::at_rest)
     spdlog::info("the coal is at rest at t = {:.4g} s: kinetic energy {:.3g} J/m, below {:g} of its peak {:.3g} J/m",
-                 coupler.time(), solid.kinetic_energy(), *header.rest_fraction, rest.peak());
+                 coupler.time(), solid.kinetic_energy(), *header.rest_fraction, loop.peak_kinetic_energy());
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   spdlog::info("done: {} windows, {} sub-iterations, {} MPM steps, {:.3g} s wall; gas released {:.4g} m3/m, "
                "{} particles left the grid",
-               coupler.records().size(), iterations, solid.steps(), wall, seepage_solver.balance().total_outflow(),
+               coupler.records().size(), driver.iterations, solid.steps(), wall, seepage_solver.balance().total_outflow(),
                solid.removed_particles());
   spdlog::info("results: {}", std::filesystem::absolute(directory).string());
   return 0;

@@ -115,18 +115,6 @@ void choose_window_pressure(const scene::Table& root, CoupledSetup& s) {
                why, *cs.fixed_stress_split ? ", with the fixed-stress split" : "");
 }
 
-// A fixed mpm.time_step against the particles' stable step, as mpm-solid
-// checks it (before --check returns).
-void check_time_step(const scene::Table& root, const CoupledSetup& s) {
-  if (!s.solid.fixed_time_step) return;
-  const double limit = mpm::stable_time_step(s.solid.materials, s.solid.particles, s.solid.grid.h, 1.0);
-  if (*s.solid.fixed_time_step > limit)
-    root.table("mpm", "", true)->fail(
-        "time_step", fmt::format("{:.3g} s exceeds the stability limit h / (c + |v|) = {:.3g} s of this scene; use "
-                                 "a smaller step or drop the key to let the CFL condition choose",
-                                 *s.solid.fixed_time_step, limit));
-}
-
 }  // namespace
 
 CoupledSetup read_coupled_scene(scene::Table root) {
@@ -172,7 +160,7 @@ CoupledSetup read_coupled_scene(scene::Table root) {
                     "below coupling.open_below = {:g} read as open space and miss the coal's volume change): "
                     "refine the MPM (grid.cell_size, bodies' particles_per_cell) or coarsen the seepage mesh",
                     spacing, narrowest, 100 * least_fill, s.coupling.gas_solid.open_below));
-  check_time_step(root, s);
+  mpm::check_time_step(*root.table("mpm", "", true), s.solid);
   return s;
 }
 

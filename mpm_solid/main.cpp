@@ -7,6 +7,7 @@
 #include "common/output_folder.hpp"
 #include "common/program.hpp"
 #include "common/progress.hpp"
+#include "common/run_loop.hpp"
 #include "common/stop.hpp"
 #include "mpm_solid/output.hpp"
 #include "mpm_solid/scene_reader.hpp"
@@ -24,15 +25,9 @@ int run(const RunOptions& options, scene::Document& doc) {
   doc.reject_unused();
   mpm::check_run_length(*mpm_table, setup, header.end_time);
 
-  // The particles exist now: a fixed step can be checked against their CFL limit
-  // (before --check returns, so it catches an unstable step too).
+  mpm::check_time_step(*mpm_table, setup);
   mpm::Solver solver(setup.grid, std::move(setup.materials), std::move(setup.particles), setup.settings);
   const double stable = solver.stable_time_step();
-  if (setup.fixed_time_step && *setup.fixed_time_step > stable / setup.settings.courant)
-    mpm_table->fail("time_step", fmt::format("{:.3g} s exceeds the stability limit h / (c + |v|) = {:.3g} s of this "
-                                             "scene; use a smaller step or drop the key to let the CFL condition "
-                                             "choose",
-                                             *setup.fixed_time_step, stable / setup.settings.courant));
   if (!finish_reading(options, doc)) return 0;
   const OutputFolder folder(options.output_directory(), "mpm-solid", options.earlier_files());
   spdlog::info("{}: {} particles, {} x {} cells of {:g} m, stable step {:.3g} s", header.title,
@@ -60,76 +55,55 @@ int run(const RunOptions& options, scene::Document& doc) {
                  setup.settling.duration, *left);
   }
   mpm::Output out(folder.path(), info, setup.tracers, resume_run);
-  double last_snapshot_time = 0;
-  double next_output = header.output_interval;
-  RestWatch rest(header.rest_fraction);
-  CheckpointClock checkpoints(header.checkpoint_interval);
-  const auto save_checkpoint = [&] {
-    checkpoint::Writer file(folder.path(), info, checkpoint::Stage::run);
-    auto root = file.root();
-    solver.save(root.group("mpm"));
-    out.save(root.group("output"));
-    const auto run = root.group("run");
-    run.number("next_output", next_output);
-    run.number("last_snapshot_time", last_snapshot_time);
-    rest.save(run.group("rest"));
-    checkpoints.save(run.group("checkpoints"));
-    file.commit();
-  };
+  // Explicit steps of the stable size (or the scene's fixed one).
+  struct Driver {
+    mpm::Solver& solver;
+    mpm::Output& out;
+    std::optional<double> fixed_step;
+    double last_snapshot_time = 0;
+
+    double time() const { return solver.time(); }
+    LoopStep advance(double target) {
+      const double dt = std::min(fixed_step ? *fixed_step : solver.stable_time_step(), target - solver.time());
+      const auto info = solver.step(dt);
+      out.history(solver, info);
+      if (info.removed > 0) spdlog::debug("{} particles left the grid at t = {:.6g} s", info.removed, solver.time());
+      return {solver.steps(), dt, fmt::format("particles {}", solver.particles().size())};
+    }
+    double kinetic_energy() const { return solver.kinetic_energy(); }
+    void snapshot() {
+      out.snapshot(solver);
+      last_snapshot_time = solver.time();
+    }
+    void failed() const {
+      spdlog::error("the last good state is the last snapshot written, at t = {:.6g} s, in {}", last_snapshot_time,
+                    std::filesystem::absolute(out.series().index_path()).string());
+    }
+    void save(checkpoint::Out root, checkpoint::Out run) const {
+      solver.save(root.group("mpm"));
+      out.save(root.group("output"));
+      run.number("last_snapshot_time", last_snapshot_time);
+    }
+  } driver{solver, out, setup.fixed_time_step};
+  RunLoop loop(header, folder.path(), info);
   if (resume_run) {
     const auto root = restart->root();
     solver.load(root.group("mpm"));
     out.load(root.group("output"));
     const auto run = root.group("run");
-    next_output = run.number("next_output");
-    last_snapshot_time = run.number("last_snapshot_time");
-    rest.load(run.group("rest"));
-    checkpoints.load(run.group("checkpoints"));
+    driver.last_snapshot_time = run.number("last_snapshot_time");
+    loop.load(run);
     spdlog::info("restarted from {} at t = {:.9g} s, step {}", restart->path().string(), solver.time(),
                  solver.steps());
   } else {
     out.snapshot(solver);
   }
-  Progress progress("mpm", solver.time(), header.end_time, options.show_progress());
-  bool at_rest = false;
-  while (solver.time() < header.end_time * (1 - 1e-12)) {
-    const double target = std::min(next_output, header.end_time);
-    const double dt = std::min(setup.fixed_time_step ? *setup.fixed_time_step : solver.stable_time_step(),
-                               target - solver.time());
-    try {
-      const auto info = solver.step(dt);
-      out.history(solver, info);
-      if (info.removed > 0) spdlog::debug("{} particles left the grid at t = {:.6g} s", info.removed, solver.time());
-    } catch (const mpm::SimulationError&) {
-      progress.finish();
-      spdlog::error("the last good state is the last snapshot written, at t = {:.6g} s, in {}",
-                    last_snapshot_time, std::filesystem::absolute(out.series().index_path()).string());
-      throw;
-    }
-    progress.update(solver.steps(), solver.time(), dt, fmt::format("particles {}", solver.particles().size()));
-    const bool output_due = solver.time() >= target * (1 - 1e-12);
-    at_rest = rest.active() && rest.at_rest(solver.kinetic_energy());
-    const bool stop = stop_requested();  // read once: a signal may come in between
-    if (output_due || at_rest) {
-      out.snapshot(solver);
-      last_snapshot_time = solver.time();
-      if (output_due) next_output += header.output_interval;
-    }
-    if (checkpoints.due(solver.time()) || stop) save_checkpoint();
-    if (stop) {
-      // After the checkpoint: a restart drops this extra snapshot, and its
-      // folder ends as the uninterrupted run's would.
-      if (!output_due && !at_rest) out.snapshot(solver);
-      progress.finish();
-      return report_stop(solver.time(), out.series().index_path());
-    }
-    if (at_rest) break;
-  }
-  progress.finish();
+  const RunEnd end = loop.run(driver, "mpm", options.show_progress());
+  if (end == RunEnd::stopped) return report_stop(solver.time(), out.series().index_path());
   out.finish();
-  if (at_rest)
+  if (end == RunEnd::at_rest)
     spdlog::info("at rest at t = {:.4g} s: kinetic energy {:.3g} J/m, below {:g} of its peak {:.3g} J/m",
-                 solver.time(), solver.kinetic_energy(), *header.rest_fraction, rest.peak());
+                 solver.time(), solver.kinetic_energy(), *header.rest_fraction, loop.peak_kinetic_energy());
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   spdlog::info("done: {} steps, {:.3g} s wall, {:.3g} particle-steps/s, {} particles left the grid",
                solver.steps(), wall, static_cast<double>(solver.steps()) * static_cast<double>(solver.particles().size()) / wall,

@@ -403,6 +403,15 @@ void check_particle_steps(const scene::Table& mpm, const Setup& setup, double st
                                    particles, steps));
 }
 
+void check_time_step(const scene::Table& mpm, const Setup& setup) {
+  if (!setup.fixed_time_step) return;
+  const double limit = stable_time_step(setup.materials, setup.particles, setup.grid.h, 1.0);
+  if (*setup.fixed_time_step > limit)
+    mpm.fail("time_step", fmt::format("{:.3g} s exceeds the stability limit h / (c + |v|) = {:.3g} s of this scene; "
+                                      "use a smaller step or drop the key to let the CFL condition choose",
+                                      *setup.fixed_time_step, limit));
+}
+
 void check_run_length(const scene::Table& mpm, const Setup& setup, double end_time) {
   const double span = setup.settling.duration + end_time;
   if (setup.fixed_time_step) {

@@ -34,6 +34,9 @@ std::string overhang(const Grid<2>& grid, const Vec<2>& lo, const Vec<2>& hi);
 // Refuses, at mpm.courant (or mpm.time_step), a run of more steps than any
 // run may take, estimated from the stable step at the start.
 void check_run_length(const scene::Table& mpm, const Setup& setup, double end_time);
+// Refuses, at mpm.time_step, a fixed step beyond the particles' stable step
+// h / (c + |v|): every program checks it before --check returns.
+void check_time_step(const scene::Table& mpm, const Setup& setup);
 
 // Particles at n x n regular positions per grid cell, kept where `inside` holds.
 template <class Inside>

@@ -8,6 +8,7 @@
 
 #include <fmt/format.h>
 
+#include "common/interval.hpp"
 #include "mpm_solid/shape.hpp"
 #include "mpm_solid/stencil.hpp"
 
@@ -712,7 +713,7 @@ std::optional<double> Solver::settle(const Settling& stage, std::optional<double
   if (settled_) throw std::logic_error("settle: the settling stage is over");
   const double scene_damping = settings_.local_damping;
   settings_.local_damping = stage.damping;
-  while (time_ < stage.duration * (1 - 1e-12)) {
+  while (!reached(time_, stage.duration, stage.duration)) {
     step(std::min(fixed_step ? *fixed_step : stable_time_step(), stage.duration - time_));
     settling_kinetic_ = kinetic_energy();
     settling_peak_ = std::max(settling_peak_, settling_kinetic_);

@@ -8,6 +8,7 @@
 #include "common/output_folder.hpp"
 #include "common/program.hpp"
 #include "common/progress.hpp"
+#include "common/run_loop.hpp"
 #include "common/stop.hpp"
 #include "seepage_fe/output.hpp"
 #include "seepage_fe/scene_reader.hpp"
@@ -40,69 +41,54 @@ int run(const RunOptions& options, scene::Document& doc) {
   if (options.restart) restart.emplace(folder.path(), info);
   seepage::Output out(folder.path(), info, solver, options.restart);
 
-  double dt = setup.steps.first;
-  double next_output = header.output_interval;
-  long iterations = 0;
-  CheckpointClock checkpoints(header.checkpoint_interval);
-  const auto save_checkpoint = [&] {
-    checkpoint::Writer file(folder.path(), info, checkpoint::Stage::run);
-    auto root = file.root();
-    solver.save(root.group("seepage"));
-    out.save(root.group("output"));
-    const auto run = root.group("run");
-    run.number("dt", dt);
-    run.number("next_output", next_output);
-    run.count("iterations", iterations);
-    checkpoints.save(run.group("checkpoints"));
-    file.commit();
-  };
+  // One implicit step at a time, growing from the first step size; a step
+  // shortened to land on an output time does not shrink the next one.
+  struct Driver {
+    seepage::Solver& solver;
+    seepage::Output& out;
+    const seepage::TimeStepControl& steps;
+    double dt;
+    long iterations = 0;
+
+    double time() const { return solver.time(); }
+    LoopStep advance(double target) {
+      const double h = std::min(dt, target - solver.time());
+      const auto report = solver.advance(h);
+      iterations += report.nonlinear_iterations;
+      out.history(solver, h, report);
+      if (h == dt) dt = std::min(dt * steps.growth, steps.maximum);
+      return {solver.steps(), h, fmt::format("iterations {}", report.nonlinear_iterations)};
+    }
+    double kinetic_energy() const { return 0; }
+    void snapshot() { out.snapshot(solver); }
+    void save(checkpoint::Out root, checkpoint::Out run) const {
+      solver.save(root.group("seepage"));
+      out.save(root.group("output"));
+      run.number("dt", dt);
+      run.count("iterations", iterations);
+    }
+  } driver{solver, out, setup.steps, setup.steps.first};
+  RunLoop loop(header, folder.path(), info);
   if (restart) {
     const auto root = restart->root();
     solver.load(root.group("seepage"));
     out.load(root.group("output"));
     const auto run = root.group("run");
-    dt = run.number("dt");
-    next_output = run.number("next_output");
-    iterations = run.count("iterations");
-    checkpoints.load(run.group("checkpoints"));
+    driver.dt = run.number("dt");
+    driver.iterations = run.count("iterations");
+    loop.load(run);
     spdlog::info("restarted from {} at t = {:.9g} s, step {}", restart->path().string(), solver.time(),
                  solver.steps());
   } else {
     out.snapshot(solver);
   }
-
-  Progress progress("seepage", solver.time(), header.end_time, options.show_progress());
-  while (solver.time() < header.end_time * (1 - 1e-12)) {
-    const double target = std::min(next_output, header.end_time);
-    const double h = std::min(dt, target - solver.time());
-    const auto report = solver.advance(h);
-    iterations += report.nonlinear_iterations;
-    out.history(solver, h, report);
-    progress.update(solver.steps(), solver.time(), h,
-                    fmt::format("iterations {}", report.nonlinear_iterations));
-    const bool output_due = solver.time() >= target * (1 - 1e-12);
-    const bool stop = stop_requested();  // read once: a signal may come in between
-    if (output_due) {
-      out.snapshot(solver);
-      next_output += header.output_interval;
-    }
-    // A step shortened to land on an output time does not shrink the next one.
-    if (h == dt) dt = std::min(dt * setup.steps.growth, setup.steps.maximum);
-    if (checkpoints.due(solver.time()) || stop) save_checkpoint();
-    if (stop) {
-      // After the checkpoint: a restart drops this extra snapshot, and its
-      // folder ends as the uninterrupted run's would.
-      if (!output_due) out.snapshot(solver);
-      progress.finish();
-      return report_stop(solver.time(), out.series().index_path());
-    }
-  }
-  progress.finish();
+  if (loop.run(driver, "seepage", options.show_progress()) == RunEnd::stopped)
+    return report_stop(solver.time(), out.series().index_path());
 
   const auto& b = solver.balance();
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-  spdlog::info("done: {} steps, {} nonlinear iterations, {:.3g} s wall", solver.steps(), iterations, wall);
+  spdlog::info("done: {} steps, {} nonlinear iterations, {:.3g} s wall", solver.steps(), driver.iterations, wall);
   spdlog::info("gas balance: stored {:.6g} of initially {:.6g} m3/m, released {:.6g} m3/m, "
                "balance error {:.2e} (relative)",
                b.stored, b.initial_stored, b.total_outflow(),
