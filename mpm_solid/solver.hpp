@@ -96,7 +96,7 @@ struct Settings {
   // Volumetric-locking remedy: replace each particle's dilatation rate tr(L) by
   // its volume-weighted average mapped to the nodes and back (nodal dilatation
   // smoothing), leaving the deviatoric rate alone. Near-incompressible
-  // elasticity (nu = 0.4 here) and plastic flow otherwise lock and checkerboard.
+  // elasticity and plastic flow otherwise lock and checkerboard.
   bool smooth_dilatation = false;
   // Nodes lighter than this fraction of the mean particle mass are treated as
   // empty (no velocity): they would turn a finite force into a huge one.

@@ -1,5 +1,7 @@
-// Bad input gets a clear error naming the file, the line, the key and what was
-// expected: a table of broken scenes, each with the message it must produce.
+// The scene file format (common/scene.hpp): bad input gets a clear error
+// naming the file, the line, the key and what was expected (a table of broken
+// scenes, each with the message it must produce); overrides; --explain. What
+// the programs' readers make of whole scenes: test_scene_readers.cpp.
 #include <catch2/catch.hpp>
 
 #include "broken_scenes.hpp"

@@ -1,4 +1,7 @@
-// Every shipped scene is valid: read fully by its solvers, no unknown keys.
+// What the programs' scene readers make of whole scenes: every shipped scene
+// is valid (read fully, no unknown keys), and the coupled scene's checks
+// across its solvers (cells read as open space, meshes past the grid, the
+// fields the solid sends). The scene file format itself: test_scene_format.cpp.
 #include <catch2/catch.hpp>
 
 #include <filesystem>
