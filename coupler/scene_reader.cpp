@@ -9,26 +9,16 @@ namespace outburst::coupling {
 using scene::Key;
 using scene::Range;
 
-CouplingSetup read_coupling(const scene::Table& c) {
-  CouplingSetup s;
+namespace {
+
+// Defaults are the settings structs' own, written here as a scene would.
+std::string text(double v) { return fmt::format("{:g}", v); }
+
+// What the solid sends back (the fields the scene's physics use, solid_fields)
+// and when it has converged; and the Biot storage coupling's own choices.
+void read_exchange(const scene::Table& c, CouplingSetup& s) {
   SchemeSettings& sc = s.scheme;
-  sc.kind = c.choice<SchemeSettings::Kind>(
-      {"scheme", "\"one_way\" (seepage drives the solid), \"explicit\" (one staggered pass per window) or "
-                 "\"implicit\" (sub-iterations to convergence)",
-       "implicit"},
-      {{"one_way", SchemeSettings::Kind::one_way},
-       {"explicit", SchemeSettings::Kind::explicit_staggered},
-       {"implicit", SchemeSettings::Kind::implicit}});
-  s.window = c.quantity({"window", "coupling window: one seepage step, many MPM steps", "", Range::positive()},
-                        units::time);
-  sc.to_second = {std::string(pressure_field)};
-
-  // Defaults are the settings structs' own, written here as a scene would.
-  const SchemeSettings scheme_default;
-  const AccelerationSettings acceleration_default;
   const GasSolidSettings gas_default;
-  const auto text = [](double v) { return fmt::format("{:g}", v); };
-
   // The keys of the iterated schemes are read whatever the scheme, so that one
   // scene can be swept over schemes (--set coupling.scheme=...). One relative
   // measure for every field, and absolute floors for fields that start at
@@ -42,6 +32,9 @@ CouplingSetup read_coupling(const scene::Table& c) {
   const double fraction_floor = c.number({"fraction_floor", "absolute convergence of occupancy and damage (norm "
                                                             "over cells)",
                                           "1e-6", Range::non_negative()});
+  const double dilatation_floor = c.number({"dilatation_floor", "absolute convergence of the dilatation field "
+                                                                "(volume change per cell area over a window)",
+                                            "1e-12", Range::non_negative()});
   GasSolidSettings& g = s.gas_solid;
   g.biot_storage = c.boolean({"biot_storage", "the solid's volume change feeds the seepage: source -alpha "
                                               "d(eps_v)/dt (linear Darcy law only; for poroelastic checks)",
@@ -73,9 +66,6 @@ CouplingSetup read_coupling(const scene::Table& c) {
                                 "or drop the key");
     s.window_pressure = pressure == "ramp" ? stability::Pressure::ramp : stability::Pressure::end;
   }
-  const double dilatation_floor = c.number({"dilatation_floor", "absolute convergence of the dilatation field "
-                                                                "(volume change per cell area over a window)",
-                                            "1e-12", Range::non_negative()});
   g.permeability_coupling = c.boolean({"permeability_coupling", "lambda follows stress and damage (paper eqs. 12, "
                                                                 "14); false: the scene's lambda throughout",
                                        gas_default.permeability_coupling ? "true" : "false"});
@@ -89,7 +79,12 @@ CouplingSetup read_coupling(const scene::Table& c) {
       sc.to_first.push_back({std::string(f.name), rel, floor});
     }
   }
+}
 
+// How an implicit window iterates: its acceleration and its limits.
+void read_iteration(const scene::Table& c, SchemeSettings& sc) {
+  const SchemeSettings scheme_default;
+  const AccelerationSettings acceleration_default;
   auto& a = sc.acceleration;
   a.kind = c.model("acceleration", "implicit: what proposes each sub-iteration's input", a.kind,
                    acceleration_models())
@@ -113,6 +108,12 @@ CouplingSetup read_coupling(const scene::Table& c) {
                                     scheme_default.stop_on_divergence ? "stop" : "continue"},
                                    {"stop", "continue"}) == "stop";
 
+}
+
+// How the gas loads the coal, and how the coal's state sets the permeability.
+void read_gas_solid(const scene::Table& c, CouplingSetup& s) {
+  GasSolidSettings& g = s.gas_solid;
+  const GasSolidSettings gas_default;
   g.biot = c.number({"biot_coefficient", "alpha: total stress = effective - alpha p I (the paper's pore pressure "
                                          "coefficient)",
                      text(gas_default.biot), Range::between(0, 1)});
@@ -144,6 +145,27 @@ CouplingSetup read_coupling(const scene::Table& c) {
   g.open_pressure = c.quantity({"open_pressure", "gas pressure of open space",
                                 fmt::format("{:g} MPa", gas_default.open_pressure * 1e-6), Range::positive()},
                                units::pressure);
+}
+
+}  // namespace
+
+CouplingSetup read_coupling(const scene::Table& c) {
+  CouplingSetup s;
+  SchemeSettings& sc = s.scheme;
+  sc.kind = c.choice<SchemeSettings::Kind>(
+      {"scheme", "\"one_way\" (seepage drives the solid), \"explicit\" (one staggered pass per window) or "
+                 "\"implicit\" (sub-iterations to convergence)",
+       "implicit"},
+      {{"one_way", SchemeSettings::Kind::one_way},
+       {"explicit", SchemeSettings::Kind::explicit_staggered},
+       {"implicit", SchemeSettings::Kind::implicit}});
+  s.window = c.quantity({"window", "coupling window: one seepage step, many MPM steps", "", Range::positive()},
+                        units::time);
+  sc.to_second = {std::string(pressure_field)};
+
+  read_exchange(c, s);
+  read_iteration(c, sc);
+  read_gas_solid(c, s);
   return s;
 }
 

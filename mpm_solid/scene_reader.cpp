@@ -188,10 +188,9 @@ void read_tractions(const scene::Table& s, Setup& setup) {
   }
 }
 
-}  // namespace
-
-Setup read_setup(const scene::Table& s) {
-  Setup setup;
+// The solver's settings of the [mpm] table itself (scheme, shape, transfer,
+// time step, damping, gravity).
+void read_settings(const scene::Table& s, Setup& setup) {
   Settings& st = setup.settings;
   st.scheme = s.choice<Scheme>({"scheme", "\"usf\" (update stress first, the paper's), \"usl\" or \"musl\"", "usf"},
                                {{"usf", Scheme::usf}, {"usl", Scheme::usl}, {"musl", Scheme::musl}});
@@ -225,11 +224,14 @@ Setup read_setup(const scene::Table& s) {
                                         "", Range::positive()},
                                        units::time);
 
+}
+
+Grid<2> read_grid(const scene::Table& s) {
   const auto grid = s.table("grid", "the background grid", true);
   const auto origin = grid->quantity_vector({"origin", "lower-left corner", "0 m, 0 m"}, units::length, 2);
   const auto size = grid->quantity_vector({"size", "width and height", "", Range::positive()}, units::length, 2);
   const double h = grid->quantity({"cell_size", "edge of the square cells", "", Range::positive()}, units::length);
-  Grid<2>& gr = setup.grid;
+  Grid<2> gr;
   gr.h = h;
   gr.lower = {origin[0], origin[1]};
   const std::array<double, 2> cells{size[0] / h, size[1] / h};
@@ -246,6 +248,15 @@ Setup read_setup(const scene::Table& s) {
   }
   gr.upper = gr.lower + Vec<2>(gr.cells[0] * h, gr.cells[1] * h);
 
+  return gr;
+}
+
+// Nodes of a grid with its ghost layers, for the memory estimates.
+double grid_nodes(const Grid<2>& gr) {
+  return (gr.cells[0] + 1.0 + 2 * Grid<2>::ghost) * (gr.cells[1] + 1.0 + 2 * Grid<2>::ghost);
+}
+
+void read_walls(const scene::Table& s, Settings& st) {
   if (const auto walls = s.table("walls", "conditions on the grid's four edges", false)) {
     const double mu = walls->number({"friction_coefficient", "Coulomb coefficient of \"friction\" walls", "0",
                                      Range::non_negative()});
@@ -253,8 +264,11 @@ Setup read_setup(const scene::Table& s) {
     for (int w = 0; w < 4; ++w) st.walls[w] = read_wall(*walls, sides[w], mu);
   }
 
-  read_obstacles(s, st, gr);
-  read_platens(s, st, gr);
+}
+
+// [mpm.settle]; without it, no obstacle may be a support.
+void read_settling(const scene::Table& s, Setup& setup) {
+  const Settings& st = setup.settings;
   if (const auto settle = s.table("settle", "a quasi-static stage before t = 0: in-situ stress and gravity brought "
                                             "to equilibrium with local damping and the supports in place", false)) {
     setup.settling.duration = settle->quantity({"time", "length of the stage", "", Range::positive()}, units::time);
@@ -268,6 +282,10 @@ Setup read_setup(const scene::Table& s) {
                "a support is removed when [mpm.settle] ends; add that section or drop the key");
   }
 
+}
+
+// The materials, in order; returns their names.
+std::vector<std::string> read_materials(const scene::Table& s, Setup& setup) {
   std::vector<std::string> names;
   for (const auto& m : s.table_array("materials", "constitutive models, referred to by name")) {
     const std::string name = m.string({"name", "material name"});
@@ -283,6 +301,14 @@ Setup read_setup(const scene::Table& s) {
   }
   if (names.empty()) s.fail("materials", "give at least one [[mpm.materials]]");
 
+  return names;
+}
+
+// The bodies, filled with particles of their materials.
+void read_bodies(const scene::Table& s, Setup& setup, const std::vector<std::string>& names) {
+  const Grid<2>& gr = setup.grid;
+  const Settings& st = setup.settings;
+  const double h = gr.h, nodes = grid_nodes(gr);
   const auto bodies = s.table_array("bodies", "regions filled with particles");
   if (bodies.empty()) s.fail("bodies", "give at least one [[mpm.bodies]] to fill with particles");
   std::vector<BodyShape> shapes;
@@ -354,8 +380,11 @@ Setup read_setup(const scene::Table& s) {
       setup.particles.add(x, Vec<2>(v0[0], v0[1]), e.density * volume, volume, 0.5 / ppc, stress, stress_zz,
                           index);
   }
-  read_tractions(s, setup);
+}
 
+// The particles nearest the tracer points, by id.
+void read_tracers(const scene::Table& s, Setup& setup) {
+  const Grid<2>& gr = setup.grid;
   if (s.has("tracers")) {
     for (const auto& point : s.quantity_points({"tracers", "points [[\"x\", \"y\"], ...]: the particle nearest "
                                                            "each at t = 0 has its history written"},
@@ -371,6 +400,22 @@ Setup read_setup(const scene::Table& s) {
       setup.tracers.push_back(setup.particles.id[nearest]);
     }
   }
+}
+
+}  // namespace
+
+Setup read_setup(const scene::Table& s) {
+  Setup setup;
+  read_settings(s, setup);
+  setup.grid = read_grid(s);
+  read_walls(s, setup.settings);
+  read_obstacles(s, setup.settings, setup.grid);
+  read_platens(s, setup.settings, setup.grid);
+  read_settling(s, setup);
+  const auto names = read_materials(s, setup);
+  read_bodies(s, setup, names);
+  read_tractions(s, setup);
+  read_tracers(s, setup);
   return setup;
 }
 

@@ -103,19 +103,8 @@ Material read_material(const scene::Table& r, Law law) {
   return m;
 }
 
-}  // namespace
-
-Setup read_setup(const scene::Table& s, bool own_time_steps) {
-  Setup setup;
-  Model& model = setup.model;
-  model.law = s.choice({"law",
-                        "\"gas\": P = p^2 with gas content A sqrt(p) (the paper's); \"linear\": "
-                        "Darcy flow of a slightly compressible fluid, unknown p",
-                        "gas"},
-                       {"gas", "linear"}) == "gas"
-                  ? Law::gas
-                  : Law::linear;
-
+// The solver's own settings: time scheme, nonlinear solver and its limits.
+void read_settings(const scene::Table& s, Setup& setup) {
   Settings& st = setup.settings;
   st.scheme = s.choice<TimeScheme>({"time_scheme", "\"bdf2\" (second order, L-stable) or \"backward_euler\"", "bdf2"},
                                    {{"bdf2", TimeScheme::bdf2}, {"backward_euler", TimeScheme::backward_euler}});
@@ -130,6 +119,10 @@ Setup read_setup(const scene::Table& s, bool own_time_steps) {
   st.max_step_cuts = s.integer<int>(
       {"max_step_cuts", "halvings of a failing step before the run stops", "12", Range::between(0, 60)});
 
+}
+
+// The step sizes of a run of its own (a coupled run's window sets them).
+void read_time_steps(const scene::Table& s, Setup& setup, bool own_time_steps) {
   setup.steps.maximum = std::numeric_limits<double>::infinity();
   if (own_time_steps) {
     setup.steps.first = s.quantity({"time_step", "first time step", "", Range::positive()}, units::time);
@@ -144,65 +137,71 @@ Setup read_setup(const scene::Table& s, bool own_time_steps) {
     }
   }
 
-  auto mesh_or_spec = read_mesh(*s.table("mesh", "the finite element mesh", true));
+}
 
-  // Regions: on a generated mesh, boxes paint regions over the rectangle; on a
-  // Gmsh mesh, each physical surface must have a region of the same name.
-  const auto regions = s.table_array("regions", "materials and initial pressure per region");
-  if (regions.empty())
-    s.fail("regions", "give at least one [[seepage.regions]] with its material and initial pressure");
+// On a generated mesh, boxes paint regions over the rectangle, in order: a cell
+// takes the last region whose box holds its centre.
+void read_painted_regions(const std::vector<scene::Table>& regions, const scene::Table& s, StructuredMeshSpec& spec,
+                          Setup& setup) {
+  Model& model = setup.model;
   Mesh& mesh = setup.mesh;
-  if (auto* spec = std::get_if<StructuredMeshSpec>(&mesh_or_spec)) {
-    for (const auto& r : regions) {
-      StructuredMeshSpec::Region region;
-      region.name = r.string({"name", "region name (used in output and messages)"});
-      region.whole_domain = !r.has("box_min");
-      if (!region.whole_domain) {
-        const auto lo = r.quantity_vector({"box_min", "lower-left corner of the region's box"}, units::length, 2);
-        const auto hi = r.quantity_vector({"box_max", "upper-right corner of the region's box"}, units::length, 2);
-        region.box_min = {lo[0], lo[1]};
-        region.box_max = {hi[0], hi[1]};
-      }
-      spec->regions.push_back(region);
-      model.materials.push_back(read_material(r, model.law));
+  for (const auto& r : regions) {
+    StructuredMeshSpec::Region region;
+    region.name = r.string({"name", "region name (used in output and messages)"});
+    region.whole_domain = !r.has("box_min");
+    if (!region.whole_domain) {
+      const auto lo = r.quantity_vector({"box_min", "lower-left corner of the region's box"}, units::length, 2);
+      const auto hi = r.quantity_vector({"box_max", "upper-right corner of the region's box"}, units::length, 2);
+      region.box_min = {lo[0], lo[1]};
+      region.box_max = {hi[0], hi[1]};
     }
-    try {
-      mesh = make_structured_mesh(*spec);
-    } catch (const std::invalid_argument& e) {
-      s.fail("regions", e.what());
-    }
-    // A cell takes the last region whose box holds it: a region left with no
-    // cell was painted over, which the scene cannot have meant.
-    for (std::size_t r = 0; r < regions.size(); ++r)
-      if (std::find(mesh.cell_region.begin(), mesh.cell_region.end(), static_cast<int>(r)) == mesh.cell_region.end())
-        regions[r].fail(regions[r].has("box_min") ? "box_min" : "name",
-                        fmt::format("region \"{}\" holds no cell: {} (a cell belongs to the last region whose box "
-                                    "holds its centre)",
-                                    spec->regions[r].name,
-                                    spec->regions[r].whole_domain ? "a later region covers the whole mesh"
-                                                                  : "its box holds no cell centre not covered by a "
-                                                                    "later region"));
-  } else {
-    mesh = std::move(std::get<Mesh>(mesh_or_spec));
-    model.materials.resize(mesh.region_names.size());
-    std::vector<bool> given(mesh.region_names.size(), false);
-    for (const auto& r : regions) {
-      const std::string name = r.string({"name", "a physical surface name of the Gmsh mesh"});
-      const int index = mesh.region_index(name);
-      if (index < 0)
-        r.fail("name", fmt::format("the mesh has no physical surface \"{}\" (it has: {})", name,
-                                   fmt::join(mesh.region_names, ", ")));
-      if (given[index]) r.fail("name", fmt::format("region \"{}\" is given twice", name));
-      given[index] = true;
-      model.materials[index] = read_material(r, model.law);
-    }
-    for (std::size_t i = 0; i < given.size(); ++i)
-      if (!given[i])
-        s.fail("regions", fmt::format("the mesh's physical surface \"{}\" has no [[seepage.regions]] "
-                                      "entry",
-                                      mesh.region_names[i]));
+    spec.regions.push_back(region);
+    model.materials.push_back(read_material(r, model.law));
   }
+  try {
+    mesh = make_structured_mesh(spec);
+  } catch (const std::invalid_argument& e) {
+    s.fail("regions", e.what());
+  }
+  // A cell takes the last region whose box holds it: a region left with no
+  // cell was painted over, which the scene cannot have meant.
+  for (std::size_t r = 0; r < regions.size(); ++r)
+    if (std::find(mesh.cell_region.begin(), mesh.cell_region.end(), static_cast<int>(r)) == mesh.cell_region.end())
+      regions[r].fail(regions[r].has("box_min") ? "box_min" : "name",
+                      fmt::format("region \"{}\" holds no cell: {} (a cell belongs to the last region whose box "
+                                  "holds its centre)",
+                                  spec.regions[r].name,
+                                  spec.regions[r].whole_domain ? "a later region covers the whole mesh"
+                                                                : "its box holds no cell centre not covered by a "
+                                                                  "later region"));
+}
 
+// On a Gmsh mesh, each physical surface must have a region of the same name.
+void read_named_regions(const std::vector<scene::Table>& regions, const scene::Table& s, Setup& setup) {
+  Model& model = setup.model;
+  const Mesh& mesh = setup.mesh;
+  model.materials.resize(mesh.region_names.size());
+  std::vector<bool> given(mesh.region_names.size(), false);
+  for (const auto& r : regions) {
+    const std::string name = r.string({"name", "a physical surface name of the Gmsh mesh"});
+    const int index = mesh.region_index(name);
+    if (index < 0)
+      r.fail("name", fmt::format("the mesh has no physical surface \"{}\" (it has: {})", name,
+                                 fmt::join(mesh.region_names, ", ")));
+    if (given[index]) r.fail("name", fmt::format("region \"{}\" is given twice", name));
+    given[index] = true;
+    model.materials[index] = read_material(r, model.law);
+  }
+  for (std::size_t i = 0; i < given.size(); ++i)
+    if (!given[i])
+      s.fail("regions", fmt::format("the mesh's physical surface \"{}\" has no [[seepage.regions]] "
+                                    "entry",
+                                    mesh.region_names[i]));
+}
+
+void read_boundaries(const scene::Table& s, Setup& setup) {
+  Model& model = setup.model;
+  const Mesh& mesh = setup.mesh;
   for (const auto& b : s.table_array("boundaries", "boundary conditions (others: no flow)")) {
     BoundaryCondition bc;
     bc.boundary = b.string({"name", "a boundary of the mesh: left, right, bottom, top on a "
@@ -229,6 +228,31 @@ Setup read_setup(const scene::Table& s, bool own_time_steps) {
                                  units::velocity);
     model.boundary_conditions.push_back(bc);
   }
+}
+
+}  // namespace
+
+Setup read_setup(const scene::Table& s, bool own_time_steps) {
+  Setup setup;
+  Model& model = setup.model;
+  model.law = s.choice<Law>({"law",
+                             "\"gas\": P = p^2 with gas content A sqrt(p) (the paper's); \"linear\": "
+                             "Darcy flow of a slightly compressible fluid, unknown p",
+                             "gas"},
+                            {{"gas", Law::gas}, {"linear", Law::linear}});
+  read_settings(s, setup);
+  read_time_steps(s, setup, own_time_steps);
+  auto mesh_or_spec = read_mesh(*s.table("mesh", "the finite element mesh", true));
+  const auto regions = s.table_array("regions", "materials and initial pressure per region");
+  if (regions.empty())
+    s.fail("regions", "give at least one [[seepage.regions]] with its material and initial pressure");
+  if (auto* spec = std::get_if<StructuredMeshSpec>(&mesh_or_spec)) {
+    read_painted_regions(regions, s, *spec, setup);
+  } else {
+    setup.mesh = std::move(std::get<Mesh>(mesh_or_spec));
+    read_named_regions(regions, s, setup);
+  }
+  read_boundaries(s, setup);
   return setup;
 }
 
