@@ -12,6 +12,7 @@
 //     double kinetic_energy() const;             // read only with a rest criterion
 //     void snapshot();                           // write the state as a snapshot
 //     void save(checkpoint::Out root, checkpoint::Out run) const;  // its state, at a checkpoint
+//     void load(const checkpoint::In& root, const checkpoint::In& run);  // and back, on --restart
 //     void failed() const;                       // optional: a step threw (the progress line is closed)
 //   };
 
@@ -48,11 +49,16 @@ class RunLoop {
         checkpoints_(header.checkpoint_interval),
         next_output_(header.output_interval) {}
 
-  // Continues from a checkpoint's "run" group (the driver loads its own parts).
-  void load(const checkpoint::In& run) {
+  // Continues from a checkpoint of the run stage: the loop's state and the
+  // driver's (its load mirrors its save).
+  template <class Driver>
+  void resume(const checkpoint::Reader& restart, Driver& driver) {
+    const auto root = restart.root();
+    const auto run = root.group("run");
     next_output_ = run.number("next_output");
     rest_.load(run.group("rest"));
     checkpoints_.load(run.group("checkpoints"));
+    driver.load(root, run);
   }
 
   template <class Driver>

@@ -144,17 +144,17 @@ int run(const RunOptions& options, scene::Document& doc) {
       log.save(root.group("coupling_log"));
       run.count("iterations", iterations);
     }
+    void load(const checkpoint::In& root, const checkpoint::In& run) {
+      model.load(root.group("model"));
+      seepage_out.load(root.group("seepage_output"));
+      solid_out.load(root.group("mpm_output"));
+      log.load(root.group("coupling_log"));
+      iterations = run.count("iterations");
+    }
   } driver{model, seepage_out, solid_out, log};
   RunLoop loop(header, directory, info);
   if (resume_run) {
-    const auto root = restart->root();
-    model.load(root.group("model"));
-    seepage_out.load(root.group("seepage_output"));
-    solid_out.load(root.group("mpm_output"));
-    log.load(root.group("coupling_log"));
-    const auto run = root.group("run");
-    driver.iterations = run.count("iterations");
-    loop.load(run);
+    loop.resume(*restart, driver);
     spdlog::info("restarted from {} at t = {:.9g} s, window {}", restart->path().string(), coupler.time(),
                  coupler.records().size());
   } else {

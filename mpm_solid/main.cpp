@@ -84,15 +84,15 @@ int run(const RunOptions& options, scene::Document& doc) {
       out.save(root.group("output"));
       run.number("last_snapshot_time", last_snapshot_time);
     }
+    void load(const checkpoint::In& root, const checkpoint::In& run) {
+      solver.load(root.group("mpm"));
+      out.load(root.group("output"));
+      last_snapshot_time = run.number("last_snapshot_time");
+    }
   } driver{solver, out, setup.fixed_time_step};
   RunLoop loop(header, folder.path(), info);
   if (resume_run) {
-    const auto root = restart->root();
-    solver.load(root.group("mpm"));
-    out.load(root.group("output"));
-    const auto run = root.group("run");
-    driver.last_snapshot_time = run.number("last_snapshot_time");
-    loop.load(run);
+    loop.resume(*restart, driver);
     spdlog::info("restarted from {} at t = {:.9g} s, step {}", restart->path().string(), solver.time(),
                  solver.steps());
   } else {

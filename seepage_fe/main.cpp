@@ -67,16 +67,16 @@ int run(const RunOptions& options, scene::Document& doc) {
       run.number("dt", dt);
       run.count("iterations", iterations);
     }
+    void load(const checkpoint::In& root, const checkpoint::In& run) {
+      solver.load(root.group("seepage"));
+      out.load(root.group("output"));
+      dt = run.number("dt");
+      iterations = run.count("iterations");
+    }
   } driver{solver, out, setup.steps, setup.steps.first};
   RunLoop loop(header, folder.path(), info);
   if (restart) {
-    const auto root = restart->root();
-    solver.load(root.group("seepage"));
-    out.load(root.group("output"));
-    const auto run = root.group("run");
-    driver.dt = run.number("dt");
-    driver.iterations = run.count("iterations");
-    loop.load(run);
+    loop.resume(*restart, driver);
     spdlog::info("restarted from {} at t = {:.9g} s, step {}", restart->path().string(), solver.time(),
                  solver.steps());
   } else {
