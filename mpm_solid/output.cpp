@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -65,7 +66,7 @@ void Output::snapshot(const Solver& solver) {
   }
   const auto& p = solver.particles();
   const std::size_t n = p.size();
-  std::vector<double> xyz, velocity, displacement, stress, s_max, s_min, material, id, damage, plastic;
+  std::vector<double> xyz, velocity, displacement, stress, s_max, s_min;
   xyz.reserve(3 * n);
   for (std::size_t i = 0; i < n; ++i) {
     xyz.insert(xyz.end(), {p.x[i].x(), p.x[i].y(), 0.0});
@@ -77,10 +78,6 @@ void Output::snapshot(const Solver& solver) {
     const auto [hi, lo] = principal_extremes(s, p.stress_zz[i]);
     s_max.push_back(hi);
     s_min.push_back(lo);
-    material.push_back(p.material[i]);
-    id.push_back(p.id[i]);
-    damage.push_back(p.damage.empty() ? 0.0 : p.damage[i]);
-    plastic.push_back(p.plastic_strain.empty() ? 0.0 : p.plastic_strain[i]);
   }
   output::Snapshot snap(solver.time());
   snap.set_points("particles", std::move(xyz));
@@ -89,12 +86,16 @@ void Output::snapshot(const Solver& solver) {
   snap.add("particles", {"stress", output::Center::node, 6, "Pa (tension positive)", std::move(stress)});
   snap.add("particles", {"sigma_max", output::Center::node, 1, "Pa", std::move(s_max)});
   snap.add("particles", {"sigma_min", output::Center::node, 1, "Pa", std::move(s_min)});
-  snap.add("particles", {"damage", output::Center::node, 1, "", std::move(damage)});
-  snap.add("particles", {"plastic_strain", output::Center::node, 1, "", std::move(plastic)});
-  snap.add("particles", {"material", output::Center::node, 1, "", std::move(material)});
-  snap.add("particles", {"id", output::Center::node, 1, "", std::move(id)});
-  if (!p.strength_scale.empty())
-    snap.add("particles", {"strength_scale", output::Center::node, 1, "", p.strength_scale});
+  // The particles' own scalar fields, as their table says.
+  p.for_each_field([&](const auto& field, const auto& values) {
+    using Written = Particles<2>::Written;
+    if constexpr (std::is_arithmetic_v<typename std::decay_t<decltype(values)>::value_type>) {
+      if (field.written == Written::never || (values.empty() && field.written == Written::when_present)) return;
+      std::vector<double> shown(n, field.fill);
+      if (!values.empty()) std::copy(values.begin(), values.end(), shown.begin());
+      snap.add("particles", {field.name, output::Center::node, 1, field.unit, std::move(shown)});
+    }
+  });
   series_.write(snap);
 }
 

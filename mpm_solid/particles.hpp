@@ -50,8 +50,15 @@ struct Particles {
 
   // The field table: every field above once, with its checkpoint name and,
   // for an optional one, the effect that creates it and the field it starts
-  // as when created or grown (zero if none). add, keep, resize and the
-  // checkpoint run over it; a field missing here fails to compile (below).
+  // as when created or grown (zero if none); a scalar field written with the
+  // snapshots names its unit and when it is written. add, keep, resize, the
+  // checkpoint and the snapshots' scalar fields run over it; a field missing
+  // here fails to compile (below).
+  enum class Written {
+    never,
+    when_present,  // only in runs whose scene names its effect
+    always,        // its fill value where the scene lacks the effect, so readers find it in every run
+  };
   template <class T>
   struct Field {
     const char* name;
@@ -59,6 +66,8 @@ struct Particles {
     const char* effect = nullptr;              // null: every scene carries it
     std::vector<T> Particles::*starts_as = nullptr;
     double fill = 0;                           // a created scalar field's value, without starts_as
+    Written written = Written::never;
+    const char* unit = "";                     // of a written field
     bool optional() const { return effect != nullptr; }
   };
   static constexpr auto fields() {
@@ -70,15 +79,18 @@ struct Particles {
         Field<Mat<Dim>>{"stress", &P::stress}, Field<double>{"stress_zz", &P::stress_zz},
         Field<Mat<Dim>>{"velocity_gradient", &P::velocity_gradient},
         Field<Mat<Dim>>{"deformation", &P::deformation}, Field<Mat<Dim>>{"affine", &P::affine},
-        Field<std::int32_t>{"material", &P::material}, Field<std::int32_t>{"id", &P::id},
+        Field<std::int32_t>{.name = "material", .values = &P::material, .written = Written::always},
+        Field<std::int32_t>{.name = "id", .values = &P::id, .written = Written::always},
         Field<Vec<Dim>>{"external_force", &P::external_force, "loads"},
         Field<Vec<Dim>>{"surface_force", &P::surface_force, "loads"},
         Field<double>{"pore_pressure", &P::pore_pressure, "pore pressure"},
-        Field<double>{"plastic_strain", &P::plastic_strain, "plasticity"},
-        Field<double>{"damage", &P::damage, "damage"},
+        Field<double>{.name = "plastic_strain", .values = &P::plastic_strain, .effect = "plasticity",
+                      .written = Written::always},
+        Field<double>{.name = "damage", .values = &P::damage, .effect = "damage", .written = Written::always},
         Field<Mat<Dim>>{"effective_stress", &P::effective_stress, "damage", &P::stress},
         Field<double>{"effective_stress_zz", &P::effective_stress_zz, "damage", &P::stress_zz},
-        Field<double>{"strength_scale", &P::strength_scale, "heterogeneity", nullptr, 1.0});
+        Field<double>{.name = "strength_scale", .values = &P::strength_scale, .effect = "heterogeneity",
+                      .fill = 1.0, .written = Written::when_present});
   }
   template <class F>
   void for_each_field(F&& f) {
