@@ -482,7 +482,8 @@ def main(argv=None):
     args = parser.parse_args(argv)
     try:
         stale = refresh(args.root, args.check)
-    except (BlockError, OSError) as e:
+    except (BlockError, OSError, ImportError) as e:
+        # Exit code 1 means stale blocks; anything that stops the check is 2.
         print(f"readme_tables: {e}", file=sys.stderr)
         return 2
     for readme, first, name, diff in stale:

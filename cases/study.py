@@ -144,6 +144,9 @@ class Knob:
                 return ['coupling.scheme="explicit"']
             if value == "explicit_fixed_stress":
                 return ['coupling.scheme="explicit"', "coupling.fixed_stress=true"]
+            if value == "one_way":
+                raise StudyError("coupling_scheme: \"one_way\" sends nothing back, so it has no error to "
+                                 "compare; vary the scene key coupling.scheme for it")
             return ['coupling.scheme="implicit"', f'coupling.acceleration="{value}"']
         if "[*]" in self.key:
             array, rest = self.key.split("[*]")

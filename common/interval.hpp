@@ -5,8 +5,10 @@
 
 namespace outburst {
 
-// True once `time` has reached `end`, to a rounding tolerance of the span of
-// the interval it ends (a sum of steps lands on the end only to round-off).
+// True once `time` has reached `end`, to a rounding tolerance of `span` (a
+// sum of steps lands on the end only to round-off): the interval's own length
+// where it is short beside the clock (a coupling window's sub-steps), else
+// the end time itself (a run from t = 0).
 inline bool reached(double time, double end, double span) { return time >= end - 1e-12 * span; }
 
 }  // namespace outburst

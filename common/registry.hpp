@@ -18,15 +18,21 @@ class Registry {
   // Adds a model; two of one name are a programming error (std::logic_error,
   // `kind` names what they are in the message). Returns true, so that a
   // model's file can register from a constant's initialiser.
+  // The name must outlive the program (a string literal): the registry keeps
+  // a view of it.
   static bool add(const Model& model, std::string_view kind) {
+    if (frozen())
+      throw std::logic_error(fmt::format("{} \"{}\" registered after the list was taken", kind, model.name));
     if (!map().emplace(model.name, model).second)
       throw std::logic_error(fmt::format("two {} named \"{}\"", kind, model.name));
     return true;
   }
-  // Every model, by name. The list is taken at the first call: not to be
+  // Every model, by name. The list is taken at the first call, after which a
+  // registration is an error (it would be missing from the list): not to be
   // called during static initialisation.
   static const std::vector<Model>& all() {
     static const std::vector<Model> models = [] {
+      frozen() = true;
       std::vector<Model> v;
       for (const auto& [name, model] : map()) v.push_back(model);
       return v;
@@ -35,6 +41,10 @@ class Registry {
   }
 
  private:
+  static bool& frozen() {
+    static bool taken = false;
+    return taken;
+  }
   // A function's static: registrations from other files' initialisers may
   // run before any namespace-scope object of this file is constructed.
   static std::map<std::string_view, Model>& map() {

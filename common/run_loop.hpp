@@ -19,6 +19,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <string>
+#include <utility>
 
 #include "common/checkpoint.hpp"
 #include "common/field_output.hpp"
@@ -41,8 +42,9 @@ enum class RunEnd { end_time, at_rest, stopped };
 
 class RunLoop {
  public:
-  RunLoop(const SceneHeader& header, std::filesystem::path folder, const output::RunInfo& info)
-      : header_(header),
+  // Keeps `info` by reference: it outlives the run in every program.
+  RunLoop(SceneHeader header, std::filesystem::path folder, const output::RunInfo& info)
+      : header_(std::move(header)),
         folder_(std::move(folder)),
         info_(info),
         rest_(header.rest_fraction),
@@ -116,7 +118,7 @@ class RunLoop {
     file.commit();
   }
 
-  const SceneHeader& header_;
+  SceneHeader header_;
   std::filesystem::path folder_;
   const output::RunInfo& info_;
   RestWatch rest_;

@@ -87,18 +87,20 @@ struct SolidFieldInfo {
   SolidField id;
   std::string_view name;  // the coupling's and the checkpoint's
   int components;         // values per seepage cell
-  std::string_view unit;
-  // Whether a coupled run with these settings sends it (a one-way scheme
-  // sends nothing back).
+  // The [coupling] key of its absolute convergence floor (the scene reader
+  // reads each floor key once).
+  std::string_view floor_key;
+  // Whether a coupled run with these settings sends it (the scheme decides
+  // whether anything is sent back at all: a one-way scheme sends nothing).
   bool (*sent)(const GasSolidSettings&);
 };
 inline constexpr std::string_view pressure_field = "pressure";  // nodal p [Pa]
 // In the order they stack.
 inline constexpr std::array<SolidFieldInfo, 4> solid_fields{{
-    {SolidField::occupancy, "occupancy", 1, "1", [](const GasSolidSettings&) { return true; }},
-    {SolidField::stress, "stress", 3, "Pa", [](const GasSolidSettings& g) { return g.permeability_coupling; }},
-    {SolidField::damage, "damage", 1, "1", [](const GasSolidSettings& g) { return g.permeability_coupling; }},
-    {SolidField::dilatation, "dilatation", 1, "1", [](const GasSolidSettings& g) { return g.biot_storage; }},
+    {SolidField::occupancy, "occupancy", 1, "fraction_floor", [](const GasSolidSettings&) { return true; }},
+    {SolidField::stress, "stress", 3, "stress_floor", [](const GasSolidSettings& g) { return g.permeability_coupling; }},
+    {SolidField::damage, "damage", 1, "fraction_floor", [](const GasSolidSettings& g) { return g.permeability_coupling; }},
+    {SolidField::dilatation, "dilatation", 1, "dilatation_floor", [](const GasSolidSettings& g) { return g.biot_storage; }},
 }};
 constexpr std::string_view name_of(SolidField field) {
   for (const auto& f : solid_fields)

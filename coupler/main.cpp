@@ -97,7 +97,7 @@ int run(const RunOptions& options, scene::Document& doc) {
   }
   auto& seepage_solver = model.seepage();
   auto& solid = model.solid();
-  const auto& cs = model.setup().coupling;
+  const auto& cs = model.coupling_setup();
   spdlog::info("{}: {} seepage cells, {} particles, window {:.3g} s", header.title, model.mapping().mesh().num_cells(),
                solid.particles().size(), cs.window);
 

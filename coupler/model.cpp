@@ -191,7 +191,7 @@ CoupledModel::CoupledModel(CoupledSetup setup, bool settle_later) : setup_(std::
   }
   gas_solid.window_pressure = cs.window_pressure.value_or(stability::Pressure::ramp);
   seepage_side_ = std::make_unique<SeepageParticipant>(*seepage_, gas_solid);
-  solid_side_ = std::make_unique<SolidParticipant>(*solid_, *mapping_, gas_solid, seepage_side_->read("pressure"),
+  solid_side_ = std::make_unique<SolidParticipant>(*solid_, *mapping_, gas_solid, seepage_side_->read(std::string(pressure_field)),
                                                    solid.fixed_time_step);
   if (cs.total_initial_stress) {
     std::vector<double> cell_pressure;

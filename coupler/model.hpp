@@ -52,8 +52,9 @@ class CoupledModel {
   // One coupling window, cut short at `limit`.
   const WindowRecord& advance(double limit);
 
-  // The scene's settings; its mesh and particles now live in the solvers.
-  const CoupledSetup& setup() const { return setup_; }
+  // The coupling's settings (the mesh and particles of the scene's setup
+  // live in the solvers now).
+  const CouplingSetup& coupling_setup() const { return setup_.coupling; }
   seepage::Solver& seepage() { return *seepage_; }
   mpm::Solver& solid() { return *solid_; }
   const MeshMapping& mapping() const { return *mapping_; }

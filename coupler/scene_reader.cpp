@@ -1,5 +1,8 @@
 #include "coupler/scene_reader.hpp"
 
+#include <map>
+#include <string_view>
+
 #include <fmt/format.h>
 
 #include "common/units.hpp"
@@ -32,9 +35,6 @@ void read_exchange(const scene::Table& c, CouplingSetup& s) {
   const double fraction_floor = c.number({"fraction_floor", "absolute convergence of occupancy and damage (norm "
                                                             "over cells)",
                                           "1e-6", Range::non_negative()});
-  const double dilatation_floor = c.number({"dilatation_floor", "absolute convergence of the dilatation field "
-                                                                "(volume change per cell area over a window)",
-                                            "1e-12", Range::non_negative()});
   GasSolidSettings& g = s.gas_solid;
   g.biot_storage = c.boolean({"biot_storage", "the solid's volume change feeds the seepage: source -alpha "
                                               "d(eps_v)/dt (linear Darcy law only; for poroelastic checks)",
@@ -66,18 +66,18 @@ void read_exchange(const scene::Table& c, CouplingSetup& s) {
                                 "or drop the key");
     s.window_pressure = pressure == "ramp" ? stability::Pressure::ramp : stability::Pressure::end;
   }
+  const double dilatation_floor = c.number({"dilatation_floor", "absolute convergence of the dilatation field "
+                                                                "(volume change per cell area over a window)",
+                                            "1e-12", Range::non_negative()});
   g.permeability_coupling = c.boolean({"permeability_coupling", "lambda follows stress and damage (paper eqs. 12, "
                                                                 "14); false: the scene's lambda throughout",
                                        gas_default.permeability_coupling ? "true" : "false"});
   // Only what the seepage uses crosses over (and is iterated on).
   if (sc.kind != SchemeSettings::Kind::one_way) {
-    for (const auto& f : solid_fields) {
-      if (!f.sent(g)) continue;
-      const double floor = f.id == SolidField::stress       ? stress_floor
-                           : f.id == SolidField::dilatation ? dilatation_floor
-                                                            : fraction_floor;
-      sc.to_first.push_back({std::string(f.name), rel, floor});
-    }
+    const std::map<std::string_view, double> floors{
+        {"fraction_floor", fraction_floor}, {"stress_floor", stress_floor}, {"dilatation_floor", dilatation_floor}};
+    for (const auto& f : solid_fields)
+      if (f.sent(g)) sc.to_first.push_back({std::string(f.name), rel, floors.at(f.floor_key)});
   }
 }
 

@@ -75,6 +75,7 @@ int run(const RunOptions& options, scene::Document& doc) {
       out.snapshot(solver);
       last_snapshot_time = solver.time();
     }
+    // Any exception, not only a blow-up: what was written stays good.
     void failed() const {
       spdlog::error("the last good state is the last snapshot written, at t = {:.6g} s, in {}", last_snapshot_time,
                     std::filesystem::absolute(out.series().index_path()).string());
@@ -96,7 +97,7 @@ int run(const RunOptions& options, scene::Document& doc) {
     spdlog::info("restarted from {} at t = {:.9g} s, step {}", restart->path().string(), solver.time(),
                  solver.steps());
   } else {
-    out.snapshot(solver);
+    driver.snapshot();
   }
   const RunEnd end = loop.run(driver, "mpm", options.show_progress());
   if (end == RunEnd::stopped) return report_stop(solver.time(), out.series().index_path());

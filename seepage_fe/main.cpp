@@ -80,7 +80,7 @@ int run(const RunOptions& options, scene::Document& doc) {
     spdlog::info("restarted from {} at t = {:.9g} s, step {}", restart->path().string(), solver.time(),
                  solver.steps());
   } else {
-    out.snapshot(solver);
+    driver.snapshot();
   }
   if (loop.run(driver, "seepage", options.show_progress()) == RunEnd::stopped)
     return report_stop(solver.time(), out.series().index_path());

@@ -5,7 +5,11 @@ acceleration is run here without a list in this file or in CMake. Every run
 must end with exit code 0; fewer than two choices fails (the key is then not
 a choice, or the program did not list it).
 
-usage: every_choice.py PROGRAM SCENE KEY WORK_DIR [--set key=value]...
+With --models-in DIR, every model file DIR/NAME.cpp (a self-registering
+model, named as its file) must be among the words: a model whose object the
+linker dropped from the program would otherwise shorten the list unseen.
+
+usage: every_choice.py PROGRAM SCENE KEY WORK_DIR [--models-in DIR] [--set key=value]...
 """
 import json
 import os
@@ -25,9 +29,20 @@ def choices(program, scene, key, overrides):
 def main():
     program, scene, key, work = sys.argv[1:5]
     overrides = sys.argv[5:]
+    models = None
+    if "--models-in" in overrides:
+        at = overrides.index("--models-in")
+        models = overrides[at + 1]
+        overrides = overrides[:at] + overrides[at + 2:]
     words = choices(program, scene, key, overrides)
     if len(words) < 2:
         sys.exit(f"{key} takes {words}: not a choice")
+    if models is not None:
+        files = sorted(os.path.splitext(f)[0] for f in os.listdir(models) if f.endswith(".cpp"))
+        missing = [f for f in files if f not in words]
+        if missing:
+            sys.exit(f"{program} does not offer {', '.join(missing)} for {key}, though {models} holds "
+                     f"{', '.join(m + '.cpp' for m in missing)}: its registration did not reach the program")
     failed = []
     for word in words:
         command = [program, scene, "-q", "-o", os.path.join(work, word), "--overwrite",

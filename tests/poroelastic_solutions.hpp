@@ -13,6 +13,16 @@ namespace outburst::testing {
 // drained top, M_m = pi (2m + 1) / 2, T = c_v t / H^2.
 struct Terzaghi {
   double H, p0, cv;
+  // A column of height H under the load q, with Young's modulus and Poisson
+  // ratio (constrained modulus M = E (1 - nu) / ((1 + nu)(1 - 2 nu))), storage
+  // S, Biot coefficient alpha and mobility k / mu: p0 = alpha q / (alpha^2 +
+  // S M), c_v = (k / mu) / (S + alpha^2 / M).
+  static Terzaghi of_column(double height, double load, double e, double nu, double storage, double alpha,
+                            double mobility) {
+    const double m = constrained_modulus(e, nu);
+    return {height, alpha * load / (alpha * alpha + storage * m), mobility / (storage + alpha * alpha / m)};
+  }
+  static double constrained_modulus(double e, double nu) { return e * (1 - nu) / ((1 + nu) * (1 - 2 * nu)); }
   double pressure(double z, double t) const {
     double sum = 0;
     for (int m = 0; m < 400; ++m) {

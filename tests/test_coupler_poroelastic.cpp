@@ -34,10 +34,10 @@ Result run(const std::vector<std::string>& overrides) {
   auto doc = scene::Document::load(std::string(OUTBURST_SOURCE_DIR) + "/cases/terzaghi/terzaghi.toml", overrides);
   coupling::CoupledModel model(coupling::read_coupled_setup(doc->root()));
   doc->reject_unused();
-  // The scene's values (see its header): M = E (1 - nu) / ((1 + nu)(1 - 2 nu)).
+  // The scene's values (see its header).
   const double e = 1e7, nu = 0.25, q = 1e4, s = 1e-7, k_mu = 1.833e-10 / 1e-3, alpha = 1.0, height = 1.0;
-  const double m = e * (1 - nu) / ((1 + nu) * (1 - 2 * nu));
-  const Terzaghi exact{height, alpha * q / (alpha * alpha + s * m), k_mu / (s + alpha * alpha / m)};
+  const double m = Terzaghi::constrained_modulus(e, nu);
+  const Terzaghi exact = Terzaghi::of_column(height, q, e, nu, s, alpha, k_mu);
   const auto& mesh = model.mapping().mesh();
   Result r;
   const auto start = std::chrono::steady_clock::now();

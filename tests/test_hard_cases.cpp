@@ -89,8 +89,7 @@ double rms(const std::vector<double>& p, const std::vector<double>& exact) {
 Outcome terzaghi(double storage, std::vector<std::string> overrides, double end) {
   overrides.push_back(fmt::format("seepage.regions[0].storage_coefficient=\"{:.6g} Pa^-1\"", storage));
   const double e = 1e7, nu = 0.25, q = 1e4, k_mu = 1.833e-7, alpha = 1.0, height = 1.0;
-  const double m = e * (1 - nu) / ((1 + nu) * (1 - 2 * nu));
-  const Terzaghi exact{height, alpha * q / (alpha * alpha + storage * m), k_mu / (storage + alpha * alpha / m)};
+  const Terzaghi exact = Terzaghi::of_column(height, q, e, nu, storage, alpha, k_mu);
   std::vector<double> checks;
   for (double t = 0.05; t < end + 1e-9; t += 0.05) checks.push_back(t);
   return run("terzaghi/terzaghi.toml", overrides, checks,
