@@ -8,20 +8,33 @@ import pytest
 from cases import units
 
 
+NAMED = {"length": (1, 0, 0, 0), "mass": (0, 1, 0, 0), "time": (0, 0, 1, 0), "angle": (0, 0, 0, 1),
+         "pressure": (-1, 1, -2, 0)}
+
+
 def cpp_units(repo):
-    """(symbol, SI factor) of every unit common/units.cpp knows."""
+    """(symbol, SI factor, (length, mass, time, angle) exponents) of every unit
+    common/units.cpp knows, and the size its table declares."""
     with open(os.path.join(repo, "common", "units.cpp")) as f:
         source = f.read()
+    declared = int(re.search(r"std::array<NamedUnit, (\d+)> known_units", source).group(1))
     start = source.index("known_units{{")
     table = source[start:source.index("}};", start)]
-    return [(symbol, eval(factor, {"pi": math.pi})) for symbol, factor in re.findall(r'\{"(\w+)", ([^,]+),', table)]
+    rows = []
+    for symbol, factor, dimension in re.findall(r'\{"(\w+)", ([^,]+), (\w+|\{[^}]*\})\}', table):
+        exponents = NAMED[dimension] if dimension in NAMED else tuple(int(x) for x in dimension.strip("{}").split(","))
+        rows.append((symbol, eval(factor, {"pi": math.pi}), exponents))
+    return rows, declared
 
 
 def test_every_cpp_unit_means_the_same(repo):
-    known = cpp_units(repo)
-    assert len(known) > 30
-    for symbol, factor in known:
+    known, declared = cpp_units(repo)
+    assert len(known) == declared
+    for symbol, factor, (length, mass, time, angle) in known:
         assert units.si(f"1 {symbol}") == pytest.approx(factor, rel=1e-12), symbol
+        # Pint counts angles as dimensionless; the rest must match exponent by exponent.
+        dims = units.registry(f"1 {symbol}").dimensionality
+        assert (dims.get("[length]", 0), dims.get("[mass]", 0), dims.get("[time]", 0)) == (length, mass, time), symbol
 
 
 @pytest.mark.parametrize("text, si", [
