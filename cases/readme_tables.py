@@ -425,6 +425,23 @@ def grid_transfer(rows):
     return [line for piece in pieces for line in wrap(piece, 80, bullet=True)]
 
 
+@block("mpm benchmark", "mpm_solid/benchmark/mpm-benchmark.csv")
+def mpm_benchmark(rows):
+    materials = ["elastic", "drucker_prager", "elastic_damage"]
+    lines = ["| particles | shape | " + " | ".join(materials) + " | bytes per particle (own + grid) |",
+             "|---|---|---|---|---|---|"]
+    cases = {}
+    for r in rows:
+        cases.setdefault((int(r["particles"]), r["shape"]), {})[r["material"]] = r
+    for (n, shape), by_material in cases.items():
+        speeds = [f"{sci(float(by_material[m]['one_thread']), 2)} / {sci(float(by_material[m]['two_threads']), 2)}"
+                  for m in materials]
+        memory = [f"{int(float(by_material[m]['bytes_per_particle']))} + "
+                  f"{int(float(by_material[m]['grid_bytes_per_particle']))}" for m in materials]
+        lines.append(f"| {sci(n, 0)} | {shape} | " + " | ".join(speeds) + " | " + ", ".join(memory) + " |")
+    return lines
+
+
 def blocks_of(path, lines):
     """(name, first line index inside, index of the end marker) of each block in a README's lines."""
     found, open_at = [], None

@@ -800,6 +800,19 @@ double Solver::kinetic_energy() const {
   return kinetic;
 }
 
+Solver::Memory Solver::memory() const {
+  const auto bytes = [](const auto& v) { return v.capacity() * sizeof(typename std::decay_t<decltype(v)>::value_type); };
+  Memory m{0, 0};
+  particles_.for_each_field([&](const auto&, const auto& values) { m.particles += bytes(values); });
+  m.particles += bytes(displacement_);
+  for (const auto& group : members_) m.particles += bytes(group);
+  for (const auto* v : {&momentum_, &force_, &velocity_, &velocity_new_}) m.grid += bytes(*v);
+  m.grid += bytes(mass_) + bytes(node_ij_) + bytes(counted_);
+  for (const auto& t : thread_mass_) m.grid += bytes(t);
+  for (const auto& t : thread_vector_) m.grid += bytes(t);
+  return m;
+}
+
 double Solver::gravitational_energy() const {
   const auto& p = particles_;
   const int n = static_cast<int>(p.size());

@@ -258,6 +258,13 @@ class Solver {
   // at a set speed.
   const std::vector<double>& platen_force() const { return platen_force_; }
 
+  // Memory held now [bytes]: by the particles (every field, and the per-step
+  // arrays sized by them) and by the grid (the nodal arrays, one set per thread).
+  struct Memory {
+    std::size_t particles, grid;
+  };
+  Memory memory() const;
+
   Energies energies() const;
   double kinetic_energy() const;  // the part of energies() a settling stage watches [J/m]
   double strain_energy() const;

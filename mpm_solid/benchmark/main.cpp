@@ -1,11 +1,11 @@
 // mpm-benchmark: particle-steps per second of the explicit step, for elastic,
 // Drucker-Prager and elastic-damage material, linear and B-spline shapes, 1 and
-// 2 threads.
+// 2 threads, and the memory per particle (its own, and the grid's share).
 //
 // Problem: a square elastic (or plastic) block with 4 particles per cell
 // released under gravity onto a fixed floor, so that every step does real
 // work (moving particles, changing stresses).
-// Usage: mpm-benchmark [particles ...]   (default 1e4 1e5 1e6)
+// Usage: mpm-benchmark [--csv FILE] [particles ...]   (default 1e4 1e5 1e6)
 //        mpm-benchmark --unloaded [particles]   (default 1e5)
 // --unloaded: one line, the throughput of an elastic block spinning free of
 // gravity and loads (B-splines, 1 thread, best of 5): what
@@ -71,7 +71,13 @@ double unloaded_particle_steps_per_second(long particles) {
   return best;
 }
 
-double particle_steps_per_second(long particles, ShapeKind shape, Model model, int threads) {
+struct Measured {
+  double particle_steps_per_second;
+  Solver::Memory memory;
+  long particles;
+};
+
+Measured measure(long particles, ShapeKind shape, Model model, int threads) {
   omp_set_num_threads(threads);
   const int per_cell = 2;
   const int side = static_cast<int>(std::lround(std::sqrt(static_cast<double>(particles)) / per_cell));
@@ -112,7 +118,7 @@ double particle_steps_per_second(long particles, ShapeKind shape, Model model, i
   const auto start = std::chrono::steady_clock::now();
   for (int i = 0; i < steps; ++i) solver.step(dt);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return static_cast<double>(n) * steps / seconds;
+  return {static_cast<double>(n) * steps / seconds, solver.memory(), n};
 }
 
 }  // namespace
@@ -128,11 +134,23 @@ int main(int argc, char** argv) {
     return 0;
   }
   std::vector<long> sizes;
+  std::FILE* csv = nullptr;  // --csv FILE: the table also as CSV (README.md's table is written from it)
   for (int i = 1; i < argc; ++i) {
+    if (std::string(argv[i]) == "--csv" && i + 1 < argc) {
+      csv = std::fopen(argv[++i], "w");
+      if (!csv) {
+        std::fprintf(stderr, "mpm-benchmark: cannot write %s\n", argv[i]);
+        return 2;
+      }
+      std::fprintf(csv, "particles,shape,material,one_thread,two_threads,speed_up,bytes_per_particle,"
+                        "grid_bytes_per_particle\n");
+      continue;
+    }
     char* end = nullptr;
     const double n = std::strtod(argv[i], &end);
     if (*end != '\0' || n < 100) {
-      std::fprintf(stderr, "usage: mpm-benchmark [particles ...]   (numbers of at least 100; default 1e4 1e5 1e6)\n");
+      std::fprintf(stderr, "usage: mpm-benchmark [--csv FILE] [particles ...]   (numbers of at least 100; default 1e4 "
+                           "1e5 1e6)\n");
       return 2;
     }
     sizes.push_back(std::lround(n));
@@ -140,15 +158,32 @@ int main(int argc, char** argv) {
   if (sizes.empty()) sizes = {10000, 100000, 1000000};
   const int cores = omp_get_max_threads();
   std::printf("particle-steps per second (2D plane strain, 4 particles per cell), %d cores\n\n", cores);
-  std::printf("%9s %-9s %-15s %12s %12s %9s\n", "particles", "shape", "material", "1 thread", "2 threads", "speed-up");
+  // Memory per particle: the particles' own fields and per-step arrays, and
+  // the grid's nodal arrays (with 2 threads' buffers) shared out over them.
+  std::printf("%9s %-9s %-15s %12s %12s %9s %14s %14s\n", "particles", "shape", "material", "1 thread", "2 threads",
+              "speed-up", "B/particle", "grid B/part.");
   for (long n : sizes)
     for (ShapeKind shape : {ShapeKind::linear, ShapeKind::bspline})
       for (Model model : {Model::elastic, Model::drucker_prager, Model::elastic_damage}) {
-        const double one = particle_steps_per_second(n, shape, model, 1);
-        const double two = particle_steps_per_second(n, shape, model, std::min(2, cores));
-        std::printf("%9ld %-9s %-15s %12.3e %12.3e %9.2f\n", n, shape == ShapeKind::linear ? "linear" : "bspline",
-                    model_name(model), one, two, two / one);
+        const Measured one = measure(n, shape, model, 1);
+        const Measured two = measure(n, shape, model, std::min(2, cores));
+        const double count = static_cast<double>(two.particles);
+        std::printf("%9ld %-9s %-15s %12.3e %12.3e %9.2f %14.0f %14.0f\n", n,
+                    shape == ShapeKind::linear ? "linear" : "bspline", model_name(model),
+                    one.particle_steps_per_second, two.particle_steps_per_second,
+                    two.particle_steps_per_second / one.particle_steps_per_second,
+                    static_cast<double>(two.memory.particles) / count, static_cast<double>(two.memory.grid) / count);
         std::fflush(stdout);
+        if (csv)
+          std::fprintf(csv, "%ld,%s,%s,%.4e,%.4e,%.3f,%.0f,%.0f\n", n,
+                       shape == ShapeKind::linear ? "linear" : "bspline", model_name(model),
+                       one.particle_steps_per_second, two.particle_steps_per_second,
+                       two.particle_steps_per_second / one.particle_steps_per_second,
+                       static_cast<double>(two.memory.particles) / count, static_cast<double>(two.memory.grid) / count);
       }
+  if (csv && std::fclose(csv) != 0) {
+    std::fprintf(stderr, "mpm-benchmark: the CSV could not be written in full\n");
+    return 1;
+  }
   return 0;
 }
