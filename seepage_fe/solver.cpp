@@ -17,7 +17,12 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-constexpr std::size_t supernodal_threshold = 100000;
+// CHOLMOD's simplicial factorisation is faster on small meshes and its
+// supernodal one (nested dissection, BLAS) on large ones; the switch sits
+// where their times cross on the benchmark's Jacobian
+// (seepage_fe/benchmark/crossover.csv: `seepage-benchmark --csv` writes the
+// simplicial / supernodal time per size).
+constexpr std::size_t supernodal_threshold = 10000;
 
 // Adds the wall time of its scope to a counter.
 class ScopedTimer {

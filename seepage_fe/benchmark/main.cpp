@@ -3,9 +3,10 @@
 //
 // Problem (as the issue fixes it): unit square, A = 2, lambda = 0.1, P0 = 9
 // (p0 = 3), the left side drained to p = 1, backward Euler, Newton.
-// Usage: seepage-benchmark [cells per side ...]   (default 99 315 999: 1e4..1e6 unknowns; --help)
+// Usage: seepage-benchmark [--csv FILE] [cells per side ...]   (default 99 315 999: 1e4..1e6 unknowns; --help)
 #include <chrono>
 #include <cstdio>
+#include <string>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -49,14 +50,27 @@ int main(int argc, char** argv) {
   CLI::App app("Where the time of a seepage step goes, beside a bare CHOLMOD factor-and-solve of the same Jacobian",
                "seepage-benchmark");
   std::vector<int> sides{99, 315, 999};
+  std::string csv_path;
   app.add_option("cells", sides, "cells per side of the unit square, one row each (unknowns: (n + 1)^2)")
       ->check(CLI::Range(2, 4000))
       ->capture_default_str();
+  app.add_option("--csv", csv_path, "also write the rows to this CSV file (seepage_fe/benchmark/crossover.csv is "
+                                    "one, from which the solver's switch between CHOLMOD modes is set)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     // --help is a success; anything else is a bad command line (exit code 2, as every program here).
     return app.exit(e) == 0 ? 0 : 2;
+  }
+  std::FILE* csv = nullptr;
+  if (!csv_path.empty()) {
+    csv = std::fopen(csv_path.c_str(), "w");
+    if (!csv) {
+      std::fprintf(stderr, "seepage-benchmark: cannot write %s\n", csv_path.c_str());
+      return 2;
+    }
+    std::fprintf(csv, "unknowns,mode,step_s,newton_iteration_s,factor_s,solve_s,other_s,bare_s,"
+                      "simplicial_over_supernodal\n");
   }
   std::printf("BLAS: %s\n\n", blas::description().c_str());
   std::printf("%9s %7s %9s %9s %9s %9s %9s %9s %7s %10s %10s %12s\n", "unknowns", "mode", "step[s]",
@@ -103,6 +117,14 @@ int main(int argc, char** argv) {
                 other, bare, other / factor, assembly, 1e9 * assembly / static_cast<double>(solver.mesh().num_cells()),
                 simplicial / super);
     std::fflush(stdout);
+    if (csv)
+      std::fprintf(csv, "%ld,%s,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.4f\n", unknowns,
+                   supernodal ? "supernodal" : "simplicial", t.total_step / steps, t.total_step / iterations, factor,
+                   solve, other, bare, simplicial / super);
+  }
+  if (csv && std::fclose(csv) != 0) {
+    std::fprintf(stderr, "seepage-benchmark: the CSV could not be written in full\n");
+    return 1;
   }
   std::printf("\nother = assembly, residuals, Jacobian values, line search and bookkeeping per Newton "
               "iteration;\ngoal: other/factor <= 0.5 and assembly ns/cell flat across sizes.\n");
