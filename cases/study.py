@@ -95,7 +95,7 @@ def numeric(value):
 
 
 def short(value):
-    """A knob value as a person would write it (1/3 m, not 0.3333333333333333 m)."""
+    """A knob value as a person would write it (0.333 m, not 0.3333333333333333 m)."""
     parts = units.split(value) if isinstance(value, str) else None
     if parts:
         return f"{parts[0]:.3g} {parts[1]}".strip()

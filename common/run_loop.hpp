@@ -47,9 +47,9 @@ class RunLoop {
       : header_(std::move(header)),
         folder_(std::move(folder)),
         info_(info),
-        rest_(header.rest_fraction),
-        checkpoints_(header.checkpoint_interval),
-        next_output_(header.output_interval) {}
+        rest_(header_.rest_fraction),
+        checkpoints_(header_.checkpoint_interval),
+        next_output_(header_.output_interval) {}
 
   // Continues from a checkpoint of the run stage: the loop's state and the
   // driver's (its load mirrors its save).

@@ -36,7 +36,7 @@ SeepageParticipant::SeepageParticipant(seepage::Solver& solver, GasSolidSettings
   const auto nc = static_cast<Eigen::Index>(solver_.mesh().num_cells());
   for (const auto& f : solid_fields)
     received_[static_cast<std::size_t>(f.id)] =
-        Eigen::VectorXd::Constant(f.components * nc, f.id == SolidField::occupancy ? 1.0 : 0.0);
+        Eigen::VectorXd::Constant(f.components * nc, f.start);
   if (settings_.biot_storage && solver_.model().law != seepage::Law::linear)
     throw std::invalid_argument("seepage: Biot storage needs the linear Darcy law (law = \"linear\")");
   if (settings_.fixed_stress > 0) {

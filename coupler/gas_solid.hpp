@@ -87,6 +87,7 @@ struct SolidFieldInfo {
   SolidField id;
   std::string_view name;  // the coupling's and the checkpoint's
   int components;         // values per seepage cell
+  double start;           // what the seepage holds before the solid first sends it
   // The [coupling] key of its absolute convergence floor (the scene reader
   // reads each floor key once).
   std::string_view floor_key;
@@ -97,10 +98,10 @@ struct SolidFieldInfo {
 inline constexpr std::string_view pressure_field = "pressure";  // nodal p [Pa]
 // In the order they stack.
 inline constexpr std::array<SolidFieldInfo, 4> solid_fields{{
-    {SolidField::occupancy, "occupancy", 1, "fraction_floor", [](const GasSolidSettings&) { return true; }},
-    {SolidField::stress, "stress", 3, "stress_floor", [](const GasSolidSettings& g) { return g.permeability_coupling; }},
-    {SolidField::damage, "damage", 1, "fraction_floor", [](const GasSolidSettings& g) { return g.permeability_coupling; }},
-    {SolidField::dilatation, "dilatation", 1, "dilatation_floor", [](const GasSolidSettings& g) { return g.biot_storage; }},
+    {SolidField::occupancy, "occupancy", 1, 1.0, "fraction_floor", [](const GasSolidSettings&) { return true; }},
+    {SolidField::stress, "stress", 3, 0.0, "stress_floor", [](const GasSolidSettings& g) { return g.permeability_coupling; }},
+    {SolidField::damage, "damage", 1, 0.0, "fraction_floor", [](const GasSolidSettings& g) { return g.permeability_coupling; }},
+    {SolidField::dilatation, "dilatation", 1, 0.0, "dilatation_floor", [](const GasSolidSettings& g) { return g.biot_storage; }},
 }};
 constexpr std::string_view name_of(SolidField field) {
   for (const auto& f : solid_fields)
@@ -135,7 +136,7 @@ class SeepageParticipant final : public Participant {
   GasSolidSettings settings_;
   std::vector<double> lambda0_;  // the scene's conductivity per cell
   // What the solid last sent, per field of solid_fields (unsent ones keep
-  // their start: full occupancy, no stress, no damage, no dilatation).
+  // their start).
   std::array<Eigen::VectorXd, solid_fields.size()> received_;
   const Eigen::VectorXd& received(SolidField f) const { return received_[static_cast<std::size_t>(f)]; }
   // The size of the last advance: the solid's dilatation covers the window
