@@ -82,6 +82,7 @@ struct MaterialContext {
   std::string name;
   Elasticity elasticity;
   double cell_size;
+  int crack_cells;  // cells one crack spreads over (crack_cells in solver.hpp)
 };
 
 // A constitutive model a scene can name (`model = "<name>"` in

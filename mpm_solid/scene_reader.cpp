@@ -296,7 +296,7 @@ std::vector<std::string> read_materials(const scene::Table& s, Setup& setup) {
     e.density = m.quantity({"density", "mass density", "", Range::positive()}, units::density);
     e.youngs_modulus = m.quantity({"youngs_modulus", "Young's modulus E", "", Range::positive()}, units::pressure);
     e.poisson_ratio = m.number({"poisson_ratio", "Poisson's ratio", "", Range{-1.0, 0.5, false, false}});
-    setup.materials.push_back(model.read(m, {name, e, setup.grid.h}));
+    setup.materials.push_back(model.read(m, {name, e, setup.grid.h, crack_cells(setup.settings.shape)}));
     names.push_back(name);
   }
   if (names.empty()) s.fail("materials", "give at least one [[mpm.materials]]");

@@ -30,6 +30,14 @@ namespace outburst::mpm {
 enum class Scheme { usf, usl, musl };
 enum class ShapeKind { linear, gimp, bspline };
 
+// Cells a crack's strain spreads over: a jump in nodal velocity between two
+// nodes strains the one cell between them under linear shapes, and under GIMP
+// too while the particles' domains tile the cells (none reaches into its
+// neighbour's cell); under quadratic B-splines the gradient of the jump is a
+// tent two cells wide, and every particle under it breaks as the crack opens.
+// A crack band is as wide as this (tests/test_mpm_fracture.cpp measures it).
+constexpr int crack_cells(ShapeKind shape) { return shape == ShapeKind::bspline ? 2 : 1; }
+
 struct Wall {
   enum class Type { open, fixed, roller, friction };
   Type type = Type::open;

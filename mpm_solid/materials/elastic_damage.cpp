@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <string>
 #include <tuple>
 
 #include <fmt/format.h>
@@ -49,18 +50,14 @@ double largest_band_width(const DamageParameters& d, const Elasticity& e) {
 
 ElasticDamage::ElasticDamage(std::string name, Elasticity elasticity, DamageParameters damage)
     : Material(std::move(name), elasticity), parameters_(damage) {
-  const double eps_t0 = damage.tensile_strength / elasticity.youngs_modulus;
   if (!damage.fracture_energy) {
-    ultimate_strain_ = damage.ultimate_ratio * eps_t0;
+    ultimate_strain_ = damage.ultimate_ratio * (damage.tensile_strength / elasticity.youngs_modulus);
   } else {
-    if (!(damage.band_width > 0 && damage.band_width <= largest_band_width(damage, elasticity) &&
-          damage.residual_ratio > 0))
-      throw std::invalid_argument(fmt::format(
-          "material \"{}\": a crack band of {:g} m with G_f = {:g} J/m2 and a residual ratio of {:g} cannot hold",
-          this->name(), damage.band_width, *damage.fracture_energy, damage.residual_ratio));
-    const double per_volume = *damage.fracture_energy / damage.band_width;
-    ultimate_strain_ =
-        eps_t0 + (per_volume - 0.5 * damage.tensile_strength * eps_t0) / (damage.residual_ratio * damage.tensile_strength);
+    if (!(damage.band_width > 0 && damage.band_width <= largest_band_width(damage, elasticity)))
+      throw std::invalid_argument(fmt::format("material \"{}\": a crack band of {:g} m with G_f = {:g} J/m2 snaps back",
+                                              this->name(), damage.band_width, *damage.fracture_energy));
+    // The area under linear softening, f_t eps_tu / 2, times the band's width.
+    ultimate_strain_ = 2 * *damage.fracture_energy / (damage.band_width * damage.tensile_strength);
   }
   std::tie(alpha_, k0_) =
       DruckerPragerFit::coefficients(DruckerPragerFit::Kind::outer, damage.cohesion, damage.friction_angle);
@@ -103,8 +100,24 @@ double ElasticDamage::damage(double previous, const Mat<2>& effective, double ef
   double damage = previous;
   if (s1 >= scale * d.tensile_strength) {
     const double eps1 = strain(s1, s2, s3);
-    const double tensile =
-        eps1 >= scale * ultimate_strain_ ? 1.0 : 1 - d.residual_ratio * scale * d.tensile_strength / (e0 * eps1);
+    // The paper's law keeps the residual share of E0 eps_1; a crack band
+    // softens linearly from f_t to nothing at eps_tu instead, and in stress:
+    // the crack carries that share of f_t across it whatever holds the band's
+    // sides. (E0 eps_1 exceeds the stress under lateral constraint, by
+    // (lambda + 2G) / E0 = 1.2 in uniaxial strain at nu = 0.25, and so would
+    // the energy the band dissipates.) A law without a drop at the peak
+    // releases no wave that could break the coal elsewhere.
+    const double ultimate = scale * ultimate_strain_;
+    double tensile = 1.0;
+    if (eps1 < ultimate) {
+      if (!d.fracture_energy) {
+        tensile = 1 - d.residual_ratio * scale * d.tensile_strength / (e0 * eps1);
+      } else {
+        const double onset = scale * d.tensile_strength / e0;
+        const double carried = eps1 <= onset ? 1.0 : (ultimate - eps1) / (ultimate - onset);
+        tensile = 1 - carried * scale * d.tensile_strength / s1;
+      }
+    }
     damage = std::max(damage, tensile);
   }
   if (0.5 * (s1 - s3) >= scale * d.cohesion * cos_phi_ - 0.5 * (s1 + s3) * sin_phi_) {
@@ -181,29 +194,32 @@ std::unique_ptr<Material> read(const scene::Table& m, const MaterialContext& c) 
                                 units::angle);
   d.tensile_strength = m.quantity({"tensile_strength", "tensile strength f_t", "", Range::positive()},
                                   units::pressure);
-  d.residual_ratio = m.number({"residual_ratio", "residual strength / strength, in tension and compression "
-                                                 "(the paper gives none; 0.1 is common for RFPA models)",
+  d.residual_ratio = m.number({"residual_ratio", "residual strength / strength, in compression, and in tension "
+                                                 "under the local law (the paper gives none; 0.1 is common "
+                                                 "for RFPA models)",
                                "0.1", Range{0.0, 1.0, true, false}});
   if (m.has("fracture_energy")) {
-    // Crack band: the ultimate strain follows from G_f and the grid's cell,
-    // the narrowest band the grid's velocity field can open.
+    // Crack band: the ultimate strain follows from G_f and the width of the
+    // narrowest band the grid's velocity field can open.
     if (m.has("ultimate_strain_ratio"))
       m.fail("ultimate_strain_ratio", "give the ultimate strain ratio (the paper's local law) or a "
                                       "fracture_energy (a crack band), not both");
-    d.fracture_energy = m.quantity({"fracture_energy", "G_f, energy per unit crack area dissipated in tension: "
-                                                       "a crack band one grid cell wide softens so that it "
-                                                       "dissipates G_f whatever the cell size (K_Ic^2 / E)",
+    d.fracture_energy = m.quantity({"fracture_energy", "G_f, energy per unit crack area dissipated in tension "
+                                                       "(K_Ic^2 / E): a crack band as wide as a crack opens on "
+                                                       "the grid (a cell; two under B-splines) softens linearly "
+                                                       "so that it dissipates G_f whatever the cell size",
                                     "", Range::positive()},
                                    units::energy_per_area);
-    d.band_width = c.cell_size;
-    if (d.residual_ratio == 0)
-      m.fail("residual_ratio", "a crack band softens along the residual strength: give residual_ratio > 0");
+    d.band_width = c.crack_cells * c.cell_size;
     if (const double widest = largest_band_width(d, c.elasticity); d.band_width > widest)
       m.refuse("fracture_energy",
-               fmt::format("cells of {:g} m are too coarse for a crack band with G_f = {:g} J/m2: the peak alone, "
-                           "f_t^2 / (2 E), would dissipate more in a cell than G_f allows; refine "
-                           "mpm.grid.cell_size to at most 2 E G_f / f_t^2 = {:.4g} m, or raise G_f",
-                           d.band_width, *d.fracture_energy, widest));
+               fmt::format("cells of {:g} m are too coarse for a crack band with G_f = {:g} J/m2: a band {} wide "
+                           "(as wide as a crack opens under these shape functions) would dissipate more at its "
+                           "peak, f_t^2 / (2 E) per unit volume, than G_f allows; refine mpm.grid.cell_size to at "
+                           "most 2 E G_f / f_t^2 / {} = {:.4g} m, or raise G_f",
+                           c.cell_size, *d.fracture_energy,
+                           c.crack_cells == 1 ? std::string("one cell") : fmt::format("{} cells", c.crack_cells),
+                           c.crack_cells, widest / c.crack_cells));
   } else {
     d.ultimate_ratio = m.number({"ultimate_strain_ratio", "eta = ultimate tensile strain / strain at f_t, beyond "
                                                           "which D = 1 (the paper gives none; 5-10 is common); "

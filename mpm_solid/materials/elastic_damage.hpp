@@ -10,7 +10,8 @@ namespace outburst::mpm {
 //  - the undamaged (effective) stress sigma~ follows Jaumann-rate elasticity
 //    with E0; damage is read from its principal stresses and strains;
 //  - tensile damage once the largest principal stress reaches f_t:
-//    D = 1 - f_tr / (E0 eps_1) up to eps_1 = eta f_t / E0, then D = 1;
+//    D = 1 - f_tr / (E0 eps_1) up to eps_1 = eta f_t / E0, then D = 1 (or
+//    the crack band below);
 //  - shear damage once Mohr-Coulomb (c, phi) is reached:
 //    D = 1 - f_cr / (E0 |eps_3|), f_cr the residual share of the UCS;
 //  - D never decreases. The stress acting is sigma~ with its tensile principal
@@ -28,12 +29,14 @@ struct DamageParameters {
   double tensile_strength;  // f_t [Pa]
   double residual_ratio;    // f_tr / f_t = f_cr / f_c
   double ultimate_ratio;    // eta = eps_tu / eps_t0, unless a fracture energy is given
-  // Crack band: with a fracture energy G_f [J/m2] the ultimate tensile strain
-  // is set so that a band band_width [m] wide dissipates G_f per unit crack
-  // area, whatever the resolution: band_width times the area under the
-  // softening law, f_t eps_t0 / 2 + f_tr (eps_tu - eps_t0), equals G_f. A band
-  // too wide for that (the peak alone would dissipate more) is refused when
-  // the scene is read (largest_band_width).
+  // Crack band (Bazant & Oh 1983): with a fracture energy G_f [J/m2] the
+  // tensile stress carried falls linearly from f_t at eps_t0 = f_t / E0 to
+  // nothing at eps_tu = 2 G_f / (f_t band_width), so that a band band_width
+  // [m] wide dissipates G_f per unit crack area whatever the resolution. The
+  // softening is written in stress, D = 1 - f(eps_1) / sigma~_1, so that the
+  // band dissipates the same whatever constrains its sides. A band too wide
+  // for that (its peak alone would dissipate more: a snap-back) is refused
+  // when the scene is read (largest_band_width).
   std::optional<double> fracture_energy;
   double band_width = 0;
   // Largest volume of fully damaged material over its initial volume. Broken
@@ -61,7 +64,8 @@ struct DamageParameters {
 double weibull_strength_scale(const DamageParameters::Heterogeneity& h, std::int64_t id);
 
 // The widest crack band a fracture energy allows with elasticity e: the one
-// whose peak alone, f_t^2 / (2 E0) per unit volume, dissipates G_f [m].
+// whose peak alone, f_t^2 / (2 E0) per unit volume, dissipates G_f [m]
+// (then eps_tu = eps_t0).
 double largest_band_width(const DamageParameters& d, const Elasticity& e);
 
 class ElasticDamage final : public Material {
