@@ -444,6 +444,20 @@ def mpm_benchmark(rows):
     return lines
 
 
+@block("outburst convergence", "cases/outburst/convergence/convergence.csv")
+def outburst_convergence(rows):
+    from .outburst.convergence import QUANTITIES, table
+    numeric = [k for k, _ in QUANTITIES] + ["particles", "wall_s", "time_s"]
+    rows = [{k: (float(v) if k in numeric and v else v) for k, v in r.items()} for r in rows]
+    laws = list(dict.fromkeys(r["law"] for r in rows))
+    times = sorted({r["time_s"] for r in rows if not r.get("failure")})
+    lines = []
+    for time in times:
+        for law in laws:
+            lines += [line.replace("### ", "#### ") for line in table(rows, law, time)] + [""]
+    return lines[:-1]
+
+
 def blocks_of(path, lines):
     """(name, first line index inside, index of the end marker) of each block in a README's lines."""
     found, open_at = [], None

@@ -1,29 +1,52 @@
 """The outburst's headline numbers from a run's output: what its sensitivity
 study, its ensembles and its accuracy study (measure.py) compare."""
-from .report import MPA, Run, axis_row, steepest_drop, tunnel
+import numpy as np
+
+from .report import MPA, Run, axis_row, cavity, seam_bins, steepest_drop, tunnel
+
+# Edge of the bins the cavity is measured in [m]: one size for every
+# resolution, so that runs on other grids measure alike.
+CAVITY_BIN = 0.5
 
 
-def headline(directory):
+def headline(directory, time=None):
+    """The headline numbers at the run's end, or at the snapshot at `time` [s]."""
     run = Run(directory)
+    k = len(run.times) - 1
+    if time is not None:
+        k = int(np.argmin(np.abs(np.asarray(run.times) - time)))
+        if abs(run.times[k] - time) > 1e-6 * max(1.0, time):
+            raise ValueError(f"{directory}: no particle snapshot at t = {time:g} s")
+    t = run.times[k]
     where = tunnel(run.scene)
     face, axis = where["face"], 0.5 * (where["floor"] + where["roof"])
-    tr = run.tracers
-    speed = {k: tr["speed_m_per_s"][tr["tracer"] == k].max() for k in range(3)}
-    last = run.particles(-1)
+    tr = run.tracers[run.tracers["time_s"] <= t + 1e-9]
+    history = run.history[run.history["time_s"] <= t + 1e-9][-1]
+    coupling = run.coupling[run.coupling["time"] <= t + 1e-9][-1]
+    speed = {i: tr["speed_m_per_s"][tr["tracer"] == i].max() for i in range(3)}
+    last = run.particles(k)
     x, damage = last["points"], last["damage"].ravel()
     ejected = x[:, 0] < face
-    # The steepest pressure drop on the tunnel's axis at the first output and the last.
+    # The steepest pressure drop on the tunnel's axis at the first output and at t.
     row = axis_row(run.nodes, face, axis)
-    drops = [steepest_drop(run.pressure(k)[row] / MPA, run.nodes[row, 0] - face)[0] for k in (1, -1)]
+    seepage_k = int(np.argmin(np.abs(np.asarray(run.seepage_times) - t)))
+    drops = [steepest_drop(run.pressure(j)[row] / MPA, run.nodes[row, 0] - face)[0] for j in (1, seepage_k)]
+    hole = cavity(*seam_bins(run.particles(0)["points"], x, face, float(run.nodes[:, 0].max()), where["top"],
+                             CAVITY_BIN)[2:], CAVITY_BIN)
     return {
         "centre_m_per_s": speed[1], "top_m_per_s": speed[0], "bottom_m_per_s": speed[2],
         "farthest_m": face - x[:, 0].min() if ejected.any() else 0.0,
         "ejected_fraction": ejected.mean(),
         "fully_damaged_fraction": (damage >= 0.99).mean(),
-        "gas_released_m3_per_m": run.coupling["gas_released"][-1],
-        "left_grid": int(run.history["removed_total"][-1]),
+        "gas_released_m3_per_m": coupling["gas_released"],
+        "left_grid": int(history["removed_total"]),
         "first_drop_MPa_per_m": drops[0], "last_drop_MPa_per_m": drops[1],
+        "cavity_m2_per_m": hole["area"], "cavity_depth_m": hole["depth"], "cavity_height_m": hole["height"],
+        "cavity_mouth_m": hole["mouth"],
         # What the transfer and the time step took, of the gas work.
-        "transfer_share": run.history["transfer_J_per_m"][-1] / run.history["external_work_J_per_m"][-1],
-        "step_share": run.history["integration_J_per_m"][-1] / run.history["external_work_J_per_m"][-1],
+        "transfer_share": history["transfer_J_per_m"] / history["external_work_J_per_m"],
+        "step_share": history["integration_J_per_m"] / history["external_work_J_per_m"],
+        # What the damage took, of the gas work: the energy a fracture energy
+        # could change.
+        "damage_share": history["damage_J_per_m"] / history["external_work_J_per_m"],
     }

@@ -169,7 +169,7 @@ def main():
             ax.plot(distance, p, marker=".", label=f"t = {run.seepage_times[k]:.3g} s")
     ax.set_xlabel("distance from the excavation face [m]")
     ax.set_ylabel("gas pressure p [MPa]")
-    ax.set_title(f"Gas pressure along the tunnel axis (y = {mid:g} m) (Fig. 4)")
+    ax.set_title(f"Gas pressure along the tunnel axis (y = {run.nodes[row[0], 1]:.3g} m) (Fig. 4)")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     fig.savefig(out("fig4_pressure_profile.png"), dpi=130)
@@ -226,8 +226,11 @@ def pile_and_seam_figure(heights, ex, ey, fill, time, tunnel_height, path):
 
 
 def axis_row(nodes, face, mid):
-    """The seepage nodes on the tunnel's axis (y = mid) from the face inward, in order."""
-    row = np.where((np.abs(nodes[:, 1] - mid) < 1e-6) & (nodes[:, 0] >= face - 1e-9))[0]
+    """The seepage nodes on the tunnel's axis (the row of nodes nearest y = mid:
+    a mesh with an odd number of elements over the tunnel has none on it) from
+    the face inward, in order."""
+    nearest = nodes[np.argmin(np.abs(nodes[:, 1] - mid)), 1]
+    row = np.where((np.abs(nodes[:, 1] - nearest) < 1e-6) & (nodes[:, 0] >= face - 1e-9))[0]
     return row[np.argsort(nodes[row, 0])]
 
 

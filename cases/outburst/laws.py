@@ -1,0 +1,31 @@
+"""The outburst scene under another tensile damage law: outburst.toml keeps the
+paper's local law (an ultimate strain ratio); a crack band replaces that line
+with a fracture energy. The scene's one relative path, its seepage mesh, is
+made absolute, so the copy may live in a study's folder."""
+import os
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SHIPPED = os.path.join(HERE, "outburst.toml")
+LOCAL_LINE = "ultimate_strain_ratio = 5"
+MESH_LINE = 'file = "seam.msh"'
+
+# G_f = K_Ic^2 / E, E = 6 GPa (Table 1), with the fracture toughness of coal in
+# semi-circular bend tests (issue 17): about 0.12 MPa m^0.5 for outburst-prone
+# coal and 0.31 for coal that does not burst.
+FRACTURE_ENERGY = {"outburst-prone": "2.4 J/m2", "non-outburst": "16 J/m2"}
+
+
+def crack_band_scene(folder, fracture_energy=FRACTURE_ENERGY["outburst-prone"]):
+    """outburst.toml with a crack band of the given G_f, written into folder; its path."""
+    with open(SHIPPED) as f:
+        text = f.read()
+    for line in (LOCAL_LINE, MESH_LINE):
+        if text.count(line) != 1:
+            raise SystemExit(f"{SHIPPED} no longer has one line '{line}' to replace")
+    text = text.replace(LOCAL_LINE, f'fracture_energy = "{fracture_energy}"  # crack band (cases/outburst/laws.py)')
+    text = text.replace(MESH_LINE, f'file = "{os.path.join(HERE, "seam.msh")}"')
+    os.makedirs(folder, exist_ok=True)
+    path = os.path.join(folder, f"outburst_crack_band_{fracture_energy.split()[0]}.toml")
+    with open(path, "w") as f:
+        f.write(text)
+    return path
