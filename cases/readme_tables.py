@@ -458,6 +458,13 @@ def outburst_convergence(rows):
     return lines[:-1]
 
 
+@block("outburst fracture sensitivity", "cases/outburst/convergence/sensitivity.csv")
+def outburst_fracture_sensitivity(rows):
+    from .outburst.sensitivity import table
+    text = ("variant", "failure")
+    return table([{k: (v if k in text or not v else float(v)) for k, v in r.items()} for r in rows])
+
+
 def blocks_of(path, lines):
     """(name, first line index inside, index of the end marker) of each block in a README's lines."""
     found, open_at = [], None

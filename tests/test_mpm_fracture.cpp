@@ -179,8 +179,9 @@ namespace {
 // plate pressed down at a set speed, each support a plate held still. Grids of
 // 2 and 4 cells across the notch, so that its edges and its middle lie on grid
 // lines (with 3 the crack starts at one of the notch's corners, not above its
-// middle: 4 % from the others' curves), and linear shape functions: the notch's
-// faces share no node, and the crack band softens as the cohesive crack.
+// middle, and its curve departs from the others'), and linear shape functions:
+// the notch's faces share no node, and the crack band softens as the cohesive
+// crack.
 constexpr double depth = 0.1, span = 0.4, notch = 0.05, width = 0.0125;           // [m]
 constexpr double notch_left = 18 * width, centre = notch_left + 0.5 * width;      // [m]
 constexpr double overall = 2 * centre, press = 0.005;                              // [m], [m/s]
