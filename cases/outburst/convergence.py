@@ -36,6 +36,8 @@ QUANTITIES = [
     ("fully_damaged_fraction", "fully damaged"),
     ("gas_released_m3_per_m", "gas released [m3/m]"),
     ("cavity_m2_per_m", "cavity [m2/m]"),
+    ("cavity_depth_m", "cavity depth [m]"),
+    ("cavity_mouth_m", "cavity mouth [m]"),
 ]
 
 
@@ -103,7 +105,7 @@ def figure(rows, times, path):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    fig, axes = plt.subplots(2, 3, figsize=(12, 6.5), constrained_layout=True)
+    fig, axes = plt.subplots(2, (len(QUANTITIES) + 1) // 2, figsize=(16, 6.5), constrained_layout=True)
     for ax, (key, label) in zip(axes.ravel(), QUANTITIES):
         for law, marker in zip(LAWS, "os"):
             for time, style in zip(times, ("--", "-", ":")):
