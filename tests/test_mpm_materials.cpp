@@ -285,3 +285,33 @@ TEST_CASE("heterogeneous coal: a particle's damage starts at its own share of th
   for (int k = 0; k < 6; ++k)
     CHECK(p.strength_scale[k] == (k % 2 ? weibull_strength_scale(*d.heterogeneity, p.id[k]) : 1.0));
 }
+
+TEST_CASE("crack band: a material point dissipates G_f per band width whatever holds its sides", "[mpm][material]") {
+  // nu = 0.4 (Table 1), a band at 90 % of the snap-back limit: the onset's
+  // share of the energy is large, and (lambda + 2G) / E = 2.14.
+  DamageParameters d{1e6, 30 * deg, 0.2e6, 0.1, 5.0, 2.4};
+  d.band_width = 0.9 * largest_band_width(d, coal);
+  const ElasticDamage m("coal", coal, d);
+  const double per_volume = *d.fracture_energy / d.band_width;
+  // Stretched along x with y held (uniaxial strain: the intact coal holds a
+  // crack's sides) and with y free (uniaxial stress in the plane: the bar).
+  const double lambda = coal.lame_lambda(), modulus = lambda + 2 * coal.shear_modulus();
+  for (const bool held : {true, false}) {
+    auto p = one_particle();
+    double dissipated = 0;
+    const double dt = 1e-3, rate = 1e-9 / dt;  // eps_xx grows by 1e-9 a step
+    for (int s = 0; s < 2000000 && p.damage[0] < 1; ++s) {
+      Mat<2> l = Mat<2>::Zero();
+      l(0, 0) = rate;
+      // Free: the lateral rate that keeps the undamaged sigma_yy, and with
+      // it the acting one, at zero.
+      if (!held) l(1, 1) = -(lambda * rate + p.effective_stress[0](1, 1) / dt) / modulus;
+      p.velocity_gradient[0] = l;
+      const Dissipation r = m.update_stress(p, {0}, dt);
+      dissipated += r.damage + r.plastic;
+    }
+    INFO((held ? "sides held" : "sides free"));
+    CHECK(p.damage[0] == 1.0);
+    CHECK(dissipated / p.volume[0] == Approx(per_volume).epsilon(0.01));
+  }
+}

@@ -7,15 +7,14 @@ usage: python3 -m cases.outburst.convergence [--outburst build/coupler/outburst]
                                               [--cells 1/2 1/3 1/4 1/6 1/8] [--laws local crack_band]
                                               [--end-time "1 s"] [--resume]
 writes OUT/convergence.csv (a row per law, cell and time measured at),
-OUT/convergence.md (the headline numbers, the change between the two finest
-cells and the observed order) and OUT/convergence.png; one run at a time, each
-on every core (the finest, 1/8 m, takes about 15 minutes to 1 s on 2 cores).
-Each finished run is kept in its folder (run.json): --resume measures those
-instead of running them again.
+OUT/convergence.md (the headline numbers and the change between the two finest
+cells) and OUT/convergence.png; one run at a time, each on every core (the
+finest, 1/8 m, takes 20-25 minutes to 1 s on 2 cores; the whole study about an
+hour and a half). Each finished run is kept in its folder (run.json): --resume
+measures those instead of running them again.
 """
 import argparse
 import json
-import math
 import os
 import subprocess
 from fractions import Fraction
@@ -56,24 +55,6 @@ def mesh_for(cell, out):
     return path
 
 
-def observed_order(cells, values):
-    """The order p of values against cells (the three finest) if they approach
-    a limit monotonically: (f1 - f2) / (f2 - f3) = (h1^p - h2^p) / (h2^p - h3^p),
-    solved by bisection; None when the changes do not shrink."""
-    (h1, h2, h3), (f1, f2, f3) = cells[-3:], values[-3:]
-    if (f1 - f2) * (f2 - f3) <= 0:
-        return None
-    target = (f1 - f2) / (f2 - f3)
-    ratio = lambda p: (h1 ** p - h2 ** p) / (h2 ** p - h3 ** p)
-    lo, hi = 0.01, 8.0
-    if not ratio(lo) <= target <= ratio(hi):
-        return None
-    for _ in range(60):
-        mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if ratio(mid) < target else (lo, mid)
-    return 0.5 * (lo + hi)
-
-
 def table(rows, law, time):
     """The markdown table of a law's rows measured at `time` [s]."""
     mine = [r for r in rows if r["law"] == law and (r.get("failure") or r["time_s"] == time)]
@@ -93,11 +74,6 @@ def table(rows, law, time):
         a, b = done[-2], done[-1]
         change = lambda k: f"{abs(b[k] - a[k]) / abs(b[k]):.0%}" if b[k] else "-"
         lines.append(f"| change {a['cell']} to {b['cell']} | | " + " | ".join(change(k) for k, _ in QUANTITIES) + " | |")
-    if len(done) >= 3:
-        cells = [float(Fraction(r["cell"].split()[0])) for r in done]
-        orders = [observed_order(cells, [r[k] for r in done]) for k, _ in QUANTITIES]
-        lines.append("| observed order (three finest) | | " +
-                     " | ".join("none" if p is None else f"{p:.1f}" for p in orders) + " | |")
     return lines
 
 
@@ -128,8 +104,8 @@ def write(rows, laws, times, out):
     lines = ["# Outburst: convergence with resolution", "",
              "MPM cells and seepage elements of the edge given, 2 x 2 particles per cell, measured at each time "
              "(the jet reaches the 25 m tunnel's end before 1 s on the finer grids: run-out and ejected coal are "
-             "then capped); the change between the two finest cells relative to the finest; the observed order "
-             "from the three finest where they approach a limit monotonically.", ""]
+             "then capped); the change between the two finest cells relative to the finest. Most quantities do "
+             "not approach a limit monotonically, so no order is fitted.", ""]
     for time in times:
         for law in laws:
             lines += table(rows, law, time) + [""]
@@ -167,13 +143,13 @@ def main():
             if args.resume and os.path.exists(kept):
                 with open(kept) as f:
                     run = json.load(f)
-                if run["overrides"] != overrides or run["law"] != law:
+                if run["overrides"] != overrides or run["law"] != law or run.get("scene") != scene:
                     run = None
                 else:
                     print(f"{law}, {label}: kept from {run_dir}", flush=True)
             if run is None:
                 wall, failure = run_one(args.outburst, scene, overrides, run_dir, os.cpu_count() or 1)
-                run = {"law": law, "overrides": overrides, "wall_s": wall, "failure": failure}
+                run = {"law": law, "scene": scene, "overrides": overrides, "wall_s": wall, "failure": failure}
                 with open(kept, "w") as f:
                     json.dump(run, f)
             row = {"law": law, "cell": label, "wall_s": run["wall_s"]}

@@ -17,7 +17,8 @@ def headline(directory, time=None):
         k = int(np.argmin(np.abs(np.asarray(run.times) - time)))
         if abs(run.times[k] - time) > 1e-6 * max(1.0, time):
             raise ValueError(f"{directory}: no particle snapshot at t = {time:g} s")
-    t = run.times[k]
+    # At the end, every row of the histories; at a time, those up to it.
+    t = run.times[k] if time is not None else float("inf")
     where = tunnel(run.scene)
     face, axis = where["face"], 0.5 * (where["floor"] + where["roof"])
     tr = run.tracers[run.tracers["time_s"] <= t + 1e-9]
@@ -29,7 +30,11 @@ def headline(directory, time=None):
     ejected = x[:, 0] < face
     # The steepest pressure drop on the tunnel's axis at the first output and at t.
     row = axis_row(run.nodes, face, axis)
-    seepage_k = int(np.argmin(np.abs(np.asarray(run.seepage_times) - t)))
+    seepage_k = len(run.seepage_times) - 1
+    if time is not None:
+        seepage_k = int(np.argmin(np.abs(np.asarray(run.seepage_times) - t)))
+        if abs(run.seepage_times[seepage_k] - t) > 1e-6 * max(1.0, t):
+            raise ValueError(f"{directory}: no seepage snapshot at t = {t:g} s")
     drops = [steepest_drop(run.pressure(j)[row] / MPA, run.nodes[row, 0] - face)[0] for j in (1, seepage_k)]
     hole = cavity(*seam_bins(run.particles(0)["points"], x, face, float(run.nodes[:, 0].max()), where["top"],
                              CAVITY_BIN)[2:], CAVITY_BIN)

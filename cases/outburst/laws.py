@@ -19,11 +19,14 @@ def crack_band_scene(folder, fracture_energy=FRACTURE_ENERGY["outburst-prone"]):
     """outburst.toml with a crack band of the given G_f, written into folder; its path."""
     with open(SHIPPED) as f:
         text = f.read()
-    for line in (LOCAL_LINE, MESH_LINE):
-        if text.count(line) != 1:
-            raise SystemExit(f"{SHIPPED} no longer has one line '{line}' to replace")
-    text = text.replace(LOCAL_LINE, f'fracture_energy = "{fracture_energy}"  # crack band (cases/outburst/laws.py)')
-    text = text.replace(MESH_LINE, f'file = "{os.path.join(HERE, "seam.msh")}"')
+    lines = text.splitlines(keepends=True)
+    for start in (LOCAL_LINE, MESH_LINE):
+        if sum(line.startswith(start) for line in lines) != 1:
+            raise SystemExit(f"{SHIPPED} no longer has one line starting '{start}' to replace")
+    # Whole lines, their comments with them: the local law's says where eta comes from.
+    replaced = {LOCAL_LINE: f'fracture_energy = "{fracture_energy}"  # crack band (cases/outburst/laws.py)\n',
+                MESH_LINE: f'file = "{os.path.join(HERE, "seam.msh")}"\n'}
+    text = "".join(next((new for start, new in replaced.items() if line.startswith(start)), line) for line in lines)
     os.makedirs(folder, exist_ok=True)
     path = os.path.join(folder, f"outburst_crack_band_{fracture_energy.split()[0]}.toml")
     with open(path, "w") as f:

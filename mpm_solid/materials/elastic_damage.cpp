@@ -54,8 +54,9 @@ ElasticDamage::ElasticDamage(std::string name, Elasticity elasticity, DamagePara
     ultimate_strain_ = damage.ultimate_ratio * (damage.tensile_strength / elasticity.youngs_modulus);
   } else {
     if (!(damage.band_width > 0 && damage.band_width <= largest_band_width(damage, elasticity)))
-      throw std::invalid_argument(fmt::format("material \"{}\": a crack band of {:g} m with G_f = {:g} J/m2 snaps back",
-                                              this->name(), damage.band_width, *damage.fracture_energy));
+      throw std::invalid_argument(fmt::format(
+          "material \"{}\": a crack band {:g} m wide with G_f = {:g} J/m2 (at most 2 E G_f / f_t^2 = {:g} m)",
+          this->name(), damage.band_width, *damage.fracture_energy, largest_band_width(damage, elasticity)));
     // The area under linear softening, f_t eps_tu / 2, times the band's width.
     ultimate_strain_ = 2 * *damage.fracture_energy / (damage.band_width * damage.tensile_strength);
   }
@@ -100,22 +101,23 @@ double ElasticDamage::damage(double previous, const Mat<2>& effective, double ef
   double damage = previous;
   if (s1 >= scale * d.tensile_strength) {
     const double eps1 = strain(s1, s2, s3);
-    // The paper's law keeps the residual share of E0 eps_1; a crack band
-    // softens linearly from f_t to nothing at eps_tu instead, and in stress:
-    // the crack carries that share of f_t across it whatever holds the band's
-    // sides. (E0 eps_1 exceeds the stress under lateral constraint, by
-    // (lambda + 2G) / E0 = 1.2 in uniaxial strain at nu = 0.25, and so would
-    // the energy the band dissipates.) A law without a drop at the peak
-    // releases no wave that could break the coal elsewhere.
+    // The paper's law keeps the residual share of E0 eps_1. A crack band
+    // instead carries a share of f_t that falls linearly in eps_1 from the
+    // onset, the strain at which this stress state reached f_t (eps_1 f_t /
+    // sigma~_1 under proportional loading), to nothing at eps_tu: the area
+    // under the curve is f_t eps_tu / 2 = G_f / w whatever holds the band's
+    // sides. (In E0 eps_1, the paper's form carries (lambda + 2G) / E0 times
+    // more under lateral constraint, and a fixed onset f_t / E0 adds a plateau
+    // at f_t: both make the band dissipate more.)
     const double ultimate = scale * ultimate_strain_;
     double tensile = 1.0;
     if (eps1 < ultimate) {
       if (!d.fracture_energy) {
         tensile = 1 - d.residual_ratio * scale * d.tensile_strength / (e0 * eps1);
       } else {
-        const double onset = scale * d.tensile_strength / e0;
-        const double carried = eps1 <= onset ? 1.0 : (ultimate - eps1) / (ultimate - onset);
-        tensile = 1 - carried * scale * d.tensile_strength / s1;
+        // onset <= eps1 < ultimate: the denominator is positive.
+        const double onset = eps1 * scale * d.tensile_strength / s1;
+        tensile = 1 - (ultimate - eps1) / (ultimate - onset) * scale * d.tensile_strength / s1;
       }
     }
     damage = std::max(damage, tensile);

@@ -30,13 +30,15 @@ struct DamageParameters {
   double residual_ratio;    // f_tr / f_t = f_cr / f_c
   double ultimate_ratio;    // eta = eps_tu / eps_t0, unless a fracture energy is given
   // Crack band (Bazant & Oh 1983): with a fracture energy G_f [J/m2] the
-  // tensile stress carried falls linearly from f_t at eps_t0 = f_t / E0 to
-  // nothing at eps_tu = 2 G_f / (f_t band_width), so that a band band_width
-  // [m] wide dissipates G_f per unit crack area whatever the resolution. The
-  // softening is written in stress, D = 1 - f(eps_1) / sigma~_1, so that the
-  // band dissipates the same whatever constrains its sides. A band too wide
-  // for that (its peak alone would dissipate more: a snap-back) is refused
-  // when the scene is read (largest_band_width).
+  // tensile stress carried falls linearly in eps_1 from f_t at the onset (the
+  // strain at which the stress state reached f_t) to nothing at
+  // eps_tu = 2 G_f / (f_t band_width): a band band_width [m] wide dissipates
+  // f_t eps_tu / 2 per unit volume, G_f per unit crack area, whatever the
+  // resolution and whatever holds the band's sides. A band too wide for that
+  // under uniaxial stress (its peak alone, f_t^2 / (2 E0) per unit volume,
+  // would dissipate more: a snap-back) is refused when the scene is read
+  // (largest_band_width); a state that stores more at its peak (lateral
+  // compression) breaks at once.
   std::optional<double> fracture_energy;
   double band_width = 0;
   // Largest volume of fully damaged material over its initial volume. Broken
