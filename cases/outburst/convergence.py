@@ -5,13 +5,13 @@ outburst-prone coal.
 
 usage: python3 -m cases.outburst.convergence [--outburst build/coupler/outburst] [--out results/outburst_convergence]
                                               [--cells 1/2 1/3 1/4 1/6 1/8] [--laws local crack_band]
-                                              [--end-time "1 s"] [--resume]
+                                              [--end-time "1 s"] [--resume | --measure-only]
 writes OUT/convergence.csv (a row per law, cell and time measured at),
 OUT/convergence.md (the headline numbers and the change between the two finest
 cells) and OUT/convergence.png; one run at a time, each on every core (the
 finest, 1/8 m, takes 20-25 minutes to 1 s on 2 cores; the whole study about an
 hour and a half). Each finished run is kept in its folder (run.json): --resume
-measures those instead of running them again.
+measures those instead of running them again, --measure-only runs nothing.
 """
 import argparse
 import json
@@ -126,6 +126,8 @@ def main():
     ap.add_argument("--at", nargs="+", type=float, default=[0.5, 1.0],
                     help="times [s] the headline numbers are measured at (multiples of 0.1 s, up to the end)")
     ap.add_argument("--resume", action="store_true", help="keep the runs an earlier study finished")
+    ap.add_argument("--measure-only", action="store_true",
+                    help="run nothing: measure the runs an earlier study finished, and list the others as not run")
     args = ap.parse_args()
     os.makedirs(args.out, exist_ok=True)
     cells = [Fraction(c) for c in args.cells]
@@ -140,13 +142,16 @@ def main():
             os.makedirs(run_dir, exist_ok=True)
             kept = os.path.join(run_dir, "run.json")
             run = None
-            if args.resume and os.path.exists(kept):
+            if (args.resume or args.measure_only) and os.path.exists(kept):
                 with open(kept) as f:
                     run = json.load(f)
                 if run["overrides"] != overrides or run["law"] != law or run.get("scene") != scene:
                     run = None
                 else:
                     print(f"{law}, {label}: kept from {run_dir}", flush=True)
+            if run is None and args.measure_only:
+                rows.append({"law": law, "cell": label, "wall_s": 0.0, "failure": "not run (--measure-only)"})
+                continue
             if run is None:
                 wall, failure = run_one(args.outburst, scene, overrides, run_dir, os.cpu_count() or 1)
                 run = {"law": law, "scene": scene, "overrides": overrides, "wall_s": wall, "failure": failure}
