@@ -16,15 +16,13 @@ measures those instead of running them again, --measure-only runs nothing.
 import argparse
 import json
 import os
-import subprocess
 from fractions import Fraction
 
 from ..runs import run_one, write_rows
 from .headline import headline
-from .laws import SHIPPED, crack_band_scene
+from .laws import SHIPPED, crack_band_scene, seam_mesh
 from .report import Run
 
-HERE = os.path.dirname(os.path.abspath(__file__))
 
 LAWS = ["local", "crack_band"]
 # The quantities compared, with their labels.
@@ -44,15 +42,6 @@ def scene_for(law, out):
     """outburst.toml under a damage law: the shipped file, or a copy with a
     crack band of outburst-prone coal's G_f (laws.py)."""
     return SHIPPED if law == "local" else crack_band_scene(out)
-
-
-def mesh_for(cell, out):
-    """The seam meshed with Gmsh at the MPM cell (seam.geo takes h)."""
-    path = os.path.abspath(os.path.join(out, f"seam_{cell.numerator}_{cell.denominator}.msh"))
-    if not os.path.exists(path):
-        subprocess.run(["gmsh", "-2", "-format", "msh41", "-setnumber", "h", repr(float(cell)),
-                        os.path.join(HERE, "seam.geo"), "-o", path], check=True, stdout=subprocess.DEVNULL)
-    return path
 
 
 def table(rows, law, time):
@@ -138,7 +127,7 @@ def main():
             label = f"{cell} m"
             run_dir = os.path.join(args.out, f"{law}_{cell.numerator}_{cell.denominator}")
             overrides = [f'scene.end_time="{args.end_time}"', f'mpm.grid.cell_size="{float(cell)!r} m"',
-                         f'seepage.mesh.file="{mesh_for(cell, args.out)}"', 'output.interval="0.1 s"']
+                         f'seepage.mesh.file="{seam_mesh(args.out, cell, f"seam_{cell.numerator}_{cell.denominator}.msh")}"', 'output.interval="0.1 s"']
             os.makedirs(run_dir, exist_ok=True)
             kept = os.path.join(run_dir, "run.json")
             run = None

@@ -1,8 +1,10 @@
-"""The outburst scene under another tensile damage law: outburst.toml keeps the
-paper's local law (an ultimate strain ratio); a crack band replaces that line
-with a fracture energy. The scene's one relative path, its seepage mesh, is
-made absolute, so the copy may live in a study's folder."""
+"""The outburst scene under another tensile damage law, and its seam meshed at
+another element size: outburst.toml keeps the paper's local law (an ultimate
+strain ratio); a crack band replaces that line with a fracture energy. The
+scene's one relative path, its seepage mesh, is made absolute, so the copy may
+live in a study's folder."""
 import os
+import subprocess
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SHIPPED = os.path.join(HERE, "outburst.toml")
@@ -31,4 +33,14 @@ def crack_band_scene(folder, fracture_energy=FRACTURE_ENERGY["outburst-prone"]):
     path = os.path.join(folder, f"outburst_crack_band_{fracture_energy.split()[0]}.toml")
     with open(path, "w") as f:
         f.write(text)
+    return path
+
+
+def seam_mesh(folder, h, name):
+    """The seam meshed by Gmsh with elements of edge h [m] (seam.geo takes h) as
+    folder/name, unless it is there already; its absolute path."""
+    path = os.path.abspath(os.path.join(folder, name))
+    if not os.path.exists(path):
+        subprocess.run(["gmsh", "-2", "-format", "msh41", "-setnumber", "h", repr(float(h)),
+                        os.path.join(HERE, "seam.geo"), "-o", path], check=True, stdout=subprocess.DEVNULL)
     return path

@@ -15,13 +15,11 @@ same overrides and end time instead of running them again.
 import argparse
 import json
 import os
-import subprocess
 
 from ..runs import run_one, write_rows
 from .headline import headline
-from .laws import SHIPPED, crack_band_scene
+from .laws import SHIPPED, crack_band_scene, seam_mesh
 
-HERE = os.path.dirname(os.path.abspath(__file__))
 
 # (label, overrides): each row changes one choice of outburst.toml.
 VARIANTS = [
@@ -65,14 +63,6 @@ VARIANTS += [
 FINE_SEEPAGE_H = 0.25
 
 
-def fine_mesh(out):
-    """The seam meshed at FINE_SEEPAGE_H with Gmsh (seam.geo takes h)."""
-    path = os.path.abspath(os.path.join(out, f"seam_h{FINE_SEEPAGE_H:g}.msh"))
-    subprocess.run(["gmsh", "-2", "-format", "msh41", "-setnumber", "h", str(FINE_SEEPAGE_H),
-                    os.path.join(HERE, "seam.geo"), "-o", path], check=True, stdout=subprocess.DEVNULL)
-    return f'seepage.mesh.file="{path}"'
-
-
 def table(rows):
     """The sensitivity's markdown table; rows as sensitivity.csv holds them (numbers, or their text)."""
     lines = ["| variant | centre / top / bottom peak speed [m/s] | farthest [m] | ejected | fully damaged "
@@ -103,7 +93,9 @@ def main():
     os.makedirs(args.out, exist_ok=True)
     rows = []
     chosen = [(k, v) for k, v in enumerate(VARIANTS) if any(text in v[0] for text in args.only)]
-    mesh = fine_mesh(args.out) if any("FINE_MESH" in o for _, (_, o) in chosen) else None
+    mesh = None
+    if any("FINE_MESH" in o for _, (_, o) in chosen):
+        mesh = f'seepage.mesh.file="{seam_mesh(args.out, FINE_SEEPAGE_H, f"seam_h{FINE_SEEPAGE_H:g}.msh")}"'
     for k, (label, overrides) in chosen:
         band = [o.split("=", 1)[1] for o in overrides if o.startswith("CRACK_BAND=")]
         scene = crack_band_scene(args.out, band[0]) if band else SHIPPED
