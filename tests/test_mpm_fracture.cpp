@@ -39,6 +39,23 @@ constexpr double weak = 0.95, grip = 2.0;
 constexpr int samples = 400;
 constexpr double end = 2 * (2 * fracture_energy / (weak * strength));
 
+// A load-displacement curve sampled at u = span k / samples, linearly
+// between the steps' (u, force).
+struct Curve {
+  explicit Curve(double span) : span(span) {}
+  double span;
+  std::vector<double> force;
+  double last_u = 0, last_force = 0;
+  void add(double u, double f) {
+    for (; static_cast<int>(force.size()) < samples && span * force.size() / samples <= u;) {
+      const double at = span * force.size() / samples;
+      force.push_back(last_force + (f - last_force) * (at - last_u) / (u - last_u));
+    }
+    last_u = u;
+    last_force = f;
+  }
+};
+
 struct Pull {
   double dissipated_per_area = 0;  // by damage, over the crack area [J/m2]
   double peak_force = 0;           // [N/m]
@@ -112,18 +129,13 @@ Pull pull(double h, ShapeKind shape, bool local) {
   }
   Solver solver(gr, std::move(materials), std::move(particles), s);
   Pull r;
-  double last_u = 0, last_force = 0;
+  Curve curve(end);
   while (solver.platen_displacement()[0] < end) {
     solver.step(solver.stable_time_step());
-    const double u = solver.platen_displacement()[0], force = solver.platen_force()[0];
-    r.peak_force = std::max(r.peak_force, force);
-    for (; static_cast<int>(r.force.size()) < samples && end * r.force.size() / samples <= u;) {
-      const double at = end * r.force.size() / samples;
-      r.force.push_back(last_force + (force - last_force) * (at - last_u) / (u - last_u));
-    }
-    last_u = u;
-    last_force = force;
+    r.peak_force = std::max(r.peak_force, solver.platen_force()[0]);
+    curve.add(solver.platen_displacement()[0], solver.platen_force()[0]);
   }
+  r.force = std::move(curve.force);
   r.dissipated_per_area = solver.energies().damage / height;
   return r;
 }
@@ -147,8 +159,8 @@ TEST_CASE("crack band: a bar pulled apart dissipates G_f per crack area at every
                   b.dissipated_per_area / fracture_energy, distance(b.force, cohesive, bar_ringing()),
                   distance(b.force, pulls.front().force, bar_ringing()), b.peak_force / 1e3);
       CHECK(b.dissipated_per_area == Approx(fracture_energy).epsilon(0.02));
-      // The curves coincide.
-      CHECK(distance(b.force, pulls.front().force, bar_ringing()) < 0.05);
+      // The curves coincide with the finest run's.
+      if (pulls.size() > 1) CHECK(distance(b.force, pulls.front().force, bar_ringing()) < 0.05);
       // Under linear and GIMP shapes every particle of the band softens
       // alike: the cohesive crack's curve. Under B-splines those at the
       // tent's middle break first and its flanks last: the same energy in a
@@ -221,20 +233,12 @@ Bend bend(double h, bool local) {
   }
   materials.push_back(std::make_unique<ElasticDamage>("coal", coal, d));
   Solver solver(gr, std::move(materials), std::move(particles), s);
-  Bend r;
-  double last_u = 0, last_force = 0;
+  Curve curve(deflection);
   while (-solver.platen_displacement()[2] < deflection) {
     solver.step(solver.stable_time_step());
-    const double u = -solver.platen_displacement()[2], force = -solver.platen_force()[2];
-    for (; static_cast<int>(r.force.size()) < samples && deflection * r.force.size() / samples <= u;) {
-      const double at = deflection * r.force.size() / samples;
-      r.force.push_back(last_force + (force - last_force) * (at - last_u) / (u - last_u));
-    }
-    last_u = u;
-    last_force = force;
+    curve.add(-solver.platen_displacement()[2], -solver.platen_force()[2]);
   }
-  r.dissipated = solver.energies().damage;
-  return r;
+  return {std::move(curve.force), solver.energies().damage};
 }
 
 }  // namespace
