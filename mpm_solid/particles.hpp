@@ -44,9 +44,10 @@ struct Particles {
   std::vector<double> damage;               // D in [0, 1], irreversible (damage materials)
   std::vector<Mat<Dim>> effective_stress;   // undamaged stress sigma~ (damage materials)
   std::vector<double> effective_stress_zz;
-  // Factor on a heterogeneous material's strengths, drawn per particle (1
-  // elsewhere).
+  // Factors on a heterogeneous material's strengths and on its elastic
+  // moduli, drawn per particle (1 elsewhere).
   std::vector<double> strength_scale;
+  std::vector<double> modulus_scale;
 
   // The field table: every field above once, with its checkpoint name and,
   // for an optional one, the effect that creates it and the field it starts
@@ -90,6 +91,8 @@ struct Particles {
         Field<Mat<Dim>>{"effective_stress", &P::effective_stress, "damage", &P::stress},
         Field<double>{"effective_stress_zz", &P::effective_stress_zz, "damage", &P::stress_zz},
         Field<double>{.name = "strength_scale", .values = &P::strength_scale, .effect = "heterogeneity",
+                      .fill = 1.0, .written = Written::when_present},
+        Field<double>{.name = "modulus_scale", .values = &P::modulus_scale, .effect = "heterogeneity",
                       .fill = 1.0, .written = Written::when_present});
   }
   template <class F>

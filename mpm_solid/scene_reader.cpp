@@ -414,6 +414,12 @@ Setup read_setup(const scene::Table& s) {
   read_settling(s, setup);
   const auto names = read_materials(s, setup);
   read_bodies(s, setup, names);
+  // The materials' own particle fields (a heterogeneous coal's draws) now, so
+  // that the checks on the step see the particles as the solver will.
+  std::vector<std::vector<int>> members(setup.materials.size());
+  for (std::size_t i = 0; i < setup.particles.size(); ++i)
+    members[static_cast<std::size_t>(setup.particles.material[i])].push_back(static_cast<int>(i));
+  for (std::size_t m = 0; m < members.size(); ++m) setup.materials[m]->create_fields(setup.particles, members[m]);
   read_tractions(s, setup);
   read_tracers(s, setup);
   return setup;
@@ -472,14 +478,16 @@ void check_run_length(const scene::Table& mpm, const Setup& setup, double end_ti
   std::size_t material = 0;
   for (std::size_t i = 0; i < p.size(); ++i) {
     const std::size_t m = static_cast<std::size_t>(p.material[i]);
-    const double speed = setup.materials[m]->elasticity().p_wave_speed() + p.v[i].norm();
+    const double stiffness = p.modulus_scale.empty() ? 1.0 : p.modulus_scale[i];
+    const double speed = std::sqrt(stiffness) * setup.materials[m]->elasticity().p_wave_speed() + p.v[i].norm();
     if (speed > fastest) fastest = speed, material = m;
   }
   const double step = setup.settings.courant * setup.grid.h / fastest;
   limits::refuse_count(
       mpm, "courant", span / step, limits::max_steps, "MPM steps",
       fmt::format("settling and end_time, {:.3g} s, in stable steps of courant {:g} x cell {:g} m / {:.3g} m/s, the "
-                  "speed of the P wave of material \"{}\" (youngs_modulus, density) and its particles; change those "
+                  "speed of the P wave of material \"{}\" (youngs_modulus, density, a heterogeneity's stiffest draw) and "
+                  "its particles; change those "
                   "or shorten the run",
                   span, setup.settings.courant, setup.grid.h, fastest, setup.materials[material]->name()));
   check_particle_steps(mpm, setup, span / step);

@@ -194,9 +194,11 @@ double stable_time_step(const std::vector<std::unique_ptr<Material>>& materials,
 #pragma omp parallel for schedule(static) reduction(max : fastest)
   for (int p = 0; p < n; ++p) {
     const auto& e = materials[particles.material[p]]->elasticity();
-    // The wave speed grows as the material compresses (density rises).
+    // The wave speed grows as the material compresses (density rises), and
+    // with a heterogeneous material's draw of the moduli.
     const double density = particles.mass[p] / particles.volume[p];
-    const double c = std::sqrt((e.lame_lambda() + 2 * e.shear_modulus()) / density);
+    const double stiffness = particles.modulus_scale.empty() ? 1.0 : particles.modulus_scale[p];
+    const double c = std::sqrt(stiffness * (e.lame_lambda() + 2 * e.shear_modulus()) / density);
     fastest = std::max(fastest, c + particles.v[p].norm());
   }
   return courant * h / fastest;
@@ -606,7 +608,8 @@ void Solver::count(int i, double dt, Census& census) const {
     ++census.bad;
   else if (!grid_.inside(p.x[i]))
     ++census.escaped;
-  else if (p.v[i].squaredNorm() > wave_speed_squared_[p.material[i]])
+  else if (p.v[i].squaredNorm() >
+           (p.modulus_scale.empty() ? 1.0 : p.modulus_scale[i]) * wave_speed_squared_[p.material[i]])
     ++census.runaway;
 }
 
@@ -630,13 +633,14 @@ void Solver::remove_escaped(const Census& census, StepInfo& info) {
   // the energy is exploding. Stop before it turns into NaN.
   if (runaway > 0 && bad == 0)
     for (int i = 0; i < n; ++i) {
-      if (p.v[i].squaredNorm() <= wave_speed_squared_[p.material[i]]) continue;
+      const double stiffness = p.modulus_scale.empty() ? 1.0 : p.modulus_scale[i];
+      if (p.v[i].squaredNorm() <= stiffness * wave_speed_squared_[p.material[i]]) continue;
       throw SimulationError(fmt::format(
           "mpm: step {} (t = {:.6g} s): the energy is exploding: particle {} (material \"{}\") has a velocity "
           "of {:.3g} m/s, above its P-wave speed {:.3g} m/s; the time step may exceed the stable one, or a load "
           "is out of range",
           steps_ + 1, time_, p.id[i], materials_[p.material[i]]->name(), p.v[i].norm(),
-          std::sqrt(wave_speed_squared_[p.material[i]])));
+          std::sqrt(stiffness * wave_speed_squared_[p.material[i]])));
     }
   if (bad > 0)
     for (int i = 0; i < n; ++i) {

@@ -195,7 +195,8 @@ struct Census {
 };
 
 // Largest stable step: courant h / max over particles of (c_p + |v_p|), c_p
-// the P-wave speed of each particle's material at its current density.
+// the P-wave speed of each particle's material at its current density and
+// with its draw of the moduli (a heterogeneous material's modulus_scale).
 double stable_time_step(const std::vector<std::unique_ptr<Material>>& materials, const Particles<2>& particles,
                         double h, double courant);
 
@@ -312,7 +313,7 @@ class Solver {
   void (Solver::*kernel_)(double) = nullptr;
 
   std::vector<std::vector<int>> members_;  // particle indices per material
-  std::vector<double> wave_speed_squared_;  // per material, for the runaway check
+  std::vector<double> wave_speed_squared_;  // per material (times a particle's modulus_scale), for the runaway check
   double empty_node_mass_ = 0;
 
   // Grid fields; per-thread copies of the scattered ones avoid locks.

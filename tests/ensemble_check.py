@@ -26,8 +26,9 @@ def ensemble(program, out, seeds, jobs):
 
 
 def coal(run_dir):
+    """The particles' strength factors followed by their modulus factors."""
     with h5py.File(os.path.join(run_dir, "particles_000000.h5")) as f:
-        return f["particles/strength_scale"][()]
+        return np.concatenate([f["particles/strength_scale"][()], f["particles/modulus_scale"][()]])
 
 
 def main():
@@ -47,7 +48,7 @@ def main():
             failures.append(f"ensemble.md has no row for {label}")
     one_thread, two_threads = coal(os.path.join(side_by_side, "seed_001")), coal(os.path.join(alone, "seed_001"))
     other = coal(os.path.join(side_by_side, "seed_002"))
-    print(f"seed 1: {len(one_thread)} particles, factors {one_thread.min():.3f}-{one_thread.max():.3f}, "
+    print(f"seed 1: {len(one_thread) // 2} particles, factors {one_thread.min():.3f}-{one_thread.max():.3f}, "
           f"mean {one_thread.mean():.4f}; on two threads identical: {np.array_equal(one_thread, two_threads)}; "
           f"seed 2 differs in {np.count_nonzero(one_thread != other)} particles")
     if (os.cpu_count() or 1) > 1 and not np.array_equal(one_thread, two_threads):

@@ -8,6 +8,7 @@
 #include "mpm_solid/materials/drucker_prager.hpp"
 #include "mpm_solid/materials/elastic.hpp"
 #include "mpm_solid/materials/elastic_damage.hpp"
+#include "mpm_solid/solver.hpp"
 
 using namespace outburst;
 using namespace outburst::mpm;
@@ -228,38 +229,62 @@ TEST_CASE("elastic-damage: broken coal bulks to its bulking factor and no furthe
   CHECK(p.volume[0] == Approx(coal_damage.bulking_factor * p.volume0[0]).epsilon(1e-12));
 }
 
-TEST_CASE("heterogeneous coal: strength factors follow the Weibull law of the homogeneity index, mean 1, set by the "
-          "seed alone", "[mpm][material][damage][heterogeneity]") {
-  const double shape = GENERATE(1.5, 3.0, 6.0);
-  const DamageParameters::Heterogeneity h{shape, 7}, other{shape, 8};
-  const int n = 20000;
-  std::vector<double> u(n);
-  int same_as_other_seed = 0;
-  for (int id = 0; id < n; ++id) {
-    u[id] = weibull_strength_scale(h, id);
-    REQUIRE(u[id] == weibull_strength_scale(h, id));  // a function of the seed and the id only
-    same_as_other_seed += u[id] == weibull_strength_scale(other, id);
-  }
-  double mean = 0;
-  for (double x : u) mean += x / n;
-  // Kolmogorov-Smirnov distance to F(u) = 1 - exp(-(u / u0)^m), and the shape
-  // fitted to ln(-ln(1 - F)) = m ln u - m ln u0 (Weibull plot).
+// Kolmogorov-Smirnov distance of draws u (sorted in place) to the Weibull law
+// of shape m and mean 1, and the shape fitted to ln(-ln(1 - F)) = m ln u -
+// m ln u0 (a Weibull plot).
+std::pair<double, double> weibull_fit(std::vector<double>& u, double m) {
   std::sort(u.begin(), u.end());
-  const double u0 = 1 / std::tgamma(1 + 1 / shape);
+  const int n = static_cast<int>(u.size());
+  const double u0 = 1 / std::tgamma(1 + 1 / m);
   double ks = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;
   for (int k = 0; k < n; ++k) {
-    const double f = 1 - std::exp(-std::pow(u[k] / u0, shape));
+    const double f = 1 - std::exp(-std::pow(u[k] / u0, m));
     ks = std::max({ks, std::abs(f - double(k) / n), std::abs(f - double(k + 1) / n)});
     const double empirical = (k + 0.5) / n, x = std::log(u[k]), y = std::log(-std::log(1 - empirical));
     sx += x, sy += y, sxx += x * x, sxy += x * y;
   }
-  const double fitted = (n * sxy - sx * sy) / (n * sxx - sx * sx);
-  std::printf("\nWeibull m = %g: mean %.4f, fitted shape %.3f, KS distance %.4f, %d of %d draws equal under "
-              "another seed\n",
-              shape, mean, fitted, ks, same_as_other_seed, n);
-  CHECK(mean == Approx(1).epsilon(0.015));
-  CHECK(fitted == Approx(shape).epsilon(0.03));
-  CHECK(ks < 1.63 / std::sqrt(double(n)));  // the 1 % critical value
+  return {ks, (n * sxy - sx * sy) / (n * sxx - sx * sx)};
+}
+
+TEST_CASE("heterogeneous coal: strength and modulus factors follow the Weibull laws of their homogeneity indices, "
+          "mean 1, independent of each other and set by the seed alone",
+          "[mpm][material][damage][heterogeneity]") {
+  const double shape = GENERATE(1.5, 3.0, 6.0);
+  const double modulus_shape = 2 * shape;
+  const DamageParameters::Heterogeneity h{shape, 7, modulus_shape}, other{shape, 8, modulus_shape};
+  const int n = 20000;
+  std::vector<double> strength(n), modulus(n);
+  int same_as_other_seed = 0;
+  for (int id = 0; id < n; ++id) {
+    strength[id] = weibull_strength_scale(h, id);
+    modulus[id] = weibull_modulus_scale(h, id);
+    // Functions of the seed and the id only.
+    REQUIRE(strength[id] == weibull_strength_scale(h, id));
+    REQUIRE(modulus[id] == weibull_modulus_scale(h, id));
+    same_as_other_seed += strength[id] == weibull_strength_scale(other, id);
+    same_as_other_seed += modulus[id] == weibull_modulus_scale(other, id);
+  }
+  // Without a modulus index of its own, the moduli take the strengths'.
+  CHECK(weibull_modulus_scale({shape, 7}, 5) == weibull_modulus_scale({shape, 7, shape}, 5));
+  double mean_s = 0, mean_e = 0, s_e = 0, s_s = 0, e_e = 0;
+  for (int k = 0; k < n; ++k) {
+    mean_s += strength[k] / n, mean_e += modulus[k] / n;
+    s_e += strength[k] * modulus[k] / n, s_s += strength[k] * strength[k] / n, e_e += modulus[k] * modulus[k] / n;
+  }
+  const double correlation = (s_e - mean_s * mean_e) / std::sqrt((s_s - mean_s * mean_s) * (e_e - mean_e * mean_e));
+  auto [ks_s, fitted_s] = weibull_fit(strength, shape);
+  auto [ks_e, fitted_e] = weibull_fit(modulus, modulus_shape);
+  std::printf("\nWeibull m = %g: strengths' mean %.4f, fitted shape %.3f, KS distance %.4f; moduli (m_E = %g) mean "
+              "%.4f, fitted %.3f, KS %.4f; correlation %.4f; %d of %d draws equal under another seed\n",
+              shape, mean_s, fitted_s, ks_s, modulus_shape, mean_e, fitted_e, ks_e, correlation, same_as_other_seed,
+              2 * n);
+  CHECK(mean_s == Approx(1).epsilon(0.015));
+  CHECK(mean_e == Approx(1).epsilon(0.015));
+  CHECK(fitted_s == Approx(shape).epsilon(0.03));
+  CHECK(fitted_e == Approx(modulus_shape).epsilon(0.03));
+  CHECK(ks_s < 1.63 / std::sqrt(double(n)));  // the 1 % critical value
+  CHECK(ks_e < 1.63 / std::sqrt(double(n)));
+  CHECK(std::abs(correlation) < 2.58 / std::sqrt(double(n)));  // uncorrelated, at 1 %
   CHECK(same_as_other_seed == 0);
 }
 
@@ -282,22 +307,69 @@ TEST_CASE("heterogeneous coal: a particle's damage starts at its own share of th
   Particles<2> p;
   for (int k = 0; k < 6; ++k) p.add({0, 0}, {0, 0}, 1, 1, 0.5, Mat<2>::Zero(), 0, k % 2);
   m.create_fields(p, {1, 3, 5});
-  for (int k = 0; k < 6; ++k)
+  for (int k = 0; k < 6; ++k) {
     CHECK(p.strength_scale[k] == (k % 2 ? weibull_strength_scale(*d.heterogeneity, p.id[k]) : 1.0));
+    CHECK(p.modulus_scale[k] == (k % 2 ? weibull_modulus_scale(*d.heterogeneity, p.id[k]) : 1.0));
+  }
 }
 
-TEST_CASE("crack band: a material point dissipates G_f per band width whatever holds its sides", "[mpm][material]") {
+TEST_CASE("heterogeneous coal: a particle's modulus factor sets its wave speed, and the stiffest sets the stable step",
+          "[mpm][material][damage][heterogeneity]") {
+  DamageParameters d = coal_damage;
+  d.heterogeneity = DamageParameters::Heterogeneity{1.5, 3};
+  std::vector<std::unique_ptr<Material>> materials;
+  materials.push_back(std::make_unique<ElasticDamage>("coal", coal, d));
+  Particles<2> p;
+  for (int k = 0; k < 4000; ++k) p.add({0, 0}, {0, 0}, coal.density, 1, 0.5, Mat<2>::Zero(), 0, 0);
+  std::vector<int> all(p.size());
+  for (int k = 0; k < 4000; ++k) all[k] = k;
+  const double uniform_step = stable_time_step(materials, p, 0.1, 0.5);
+  materials[0]->create_fields(p, all);
+  const double stiffest = *std::max_element(p.modulus_scale.begin(), p.modulus_scale.end());
+  REQUIRE(stiffest > 3);  // m = 1.5: a wide spread
+  CHECK(stable_time_step(materials, p, 0.1, 0.5) == Approx(uniform_step / std::sqrt(stiffest)).epsilon(1e-12));
+  CHECK(uniform_step == Approx(0.5 * 0.1 / coal.p_wave_speed()).epsilon(1e-12));
+
+  // Uniaxial strain in one particle: its stress is the stiffness times the
+  // uniform coal's (below the strength, so undamaged).
+  auto one = one_particle();
+  one.need("heterogeneity");
+  one.strength_scale[0] = 1, one.modulus_scale[0] = 0.4;
+  Mat<2> l = Mat<2>::Zero();
+  l(0, 0) = -1e-5;
+  drive(*materials[0], one, l, 10, 0.1);
+  CHECK(one.stress[0](0, 0) == Approx(-0.4 * (coal.lame_lambda() + 2 * coal.shear_modulus()) * 1e-5).epsilon(1e-9));
+  CHECK(one.damage[0] == 0);
+  // Its strain energy with its own compliance: sigma eps / 2.
+  CHECK(materials[0]->strain_energy(one, {0}) ==
+        Approx(0.5 * -one.stress[0](0, 0) * 1e-5 * one.volume[0]).epsilon(1e-6));
+}
+
+TEST_CASE("crack band: a material point dissipates G_f per band width whatever holds its sides, and s_f^2 / s_E times as "
+          "much with factors s_f, s_E on its strength and moduli", "[mpm][material]") {
   // nu = 0.4 (Table 1), a band at 90 % of the snap-back limit: the onset's
   // share of the energy is large, and (lambda + 2G) / E = 2.14.
   DamageParameters d{1e6, 30 * deg, 0.2e6, 0.1, 5.0, 2.4};
   d.band_width = 0.9 * largest_band_width(d, coal);
-  const ElasticDamage m("coal", coal, d);
-  const double per_volume = *d.fracture_energy / d.band_width;
+  const ElasticDamage uniform("coal", coal, d);
+  d.heterogeneity = DamageParameters::Heterogeneity{3.0, 1};
+  const ElasticDamage drawn("coal", coal, d);
+  // A weak, soft particle and a strong, stiff one: each keeps its
+  // characteristic length, so the band stays within its snap-back limit.
+  const auto [strength, stiffness] = GENERATE(std::pair{1.0, 1.0}, std::pair{0.6, 0.5}, std::pair{1.7, 2.2});
+  const bool heterogeneous = strength != 1.0;
+  const Material& m = heterogeneous ? static_cast<const Material&>(drawn) : uniform;
+  const double per_volume = strength * strength / stiffness * *d.fracture_energy / d.band_width;
   // Stretched along x with y held (uniaxial strain: the intact coal holds a
   // crack's sides) and with y free (uniaxial stress in the plane: the bar).
-  const double lambda = coal.lame_lambda(), modulus = lambda + 2 * coal.shear_modulus();
+  const double lambda = stiffness * coal.lame_lambda(), modulus = lambda + 2 * stiffness * coal.shear_modulus();
   for (const bool held : {true, false}) {
     auto p = one_particle();
+    if (heterogeneous) {
+      p.need("heterogeneity");
+      p.strength_scale[0] = strength;
+      p.modulus_scale[0] = stiffness;
+    }
     double dissipated = 0;
     const double dt = 1e-3, rate = 1e-9 / dt;  // eps_xx grows by 1e-9 a step
     for (int s = 0; s < 2000000 && p.damage[0] < 1; ++s) {
@@ -310,7 +382,7 @@ TEST_CASE("crack band: a material point dissipates G_f per band width whatever h
       const Dissipation r = m.update_stress(p, {0}, dt);
       dissipated += r.damage + r.plastic;
     }
-    INFO((held ? "sides held" : "sides free"));
+    INFO((held ? "sides held" : "sides free") << ", s_f = " << strength << ", s_E = " << stiffness);
     CHECK(p.damage[0] == 1.0);
     CHECK(dissipated / p.volume[0] == Approx(per_volume).epsilon(0.01));
   }

@@ -51,7 +51,8 @@ for _grid, _cells in [("1/3 m", []), ("1/6 m", ['mpm.grid.cell_size="0.166666666
 # Fracture with a length (issue 17), after the rows above so that their run
 # folders keep their numbers: the crack band in place of eta, with each coal's
 # G_f (laws.py), and heterogeneous coal (one seed each; the ensembles give the
-# spread; under a crack band the mean G_f is E[s^2] G_f, 1.13 G_f at m = 3).
+# spread; under a crack band the mean G_f is E[s_f^2] E[1 / s_E] G_f, 1.37 G_f
+# at m = 3).
 VARIANTS += [
     ("crack band, G_f 2.4 J/m2 (outburst-prone)", ["CRACK_BAND=2.4 J/m2"]),
     ("crack band, G_f 16 J/m2 (non-outburst)", ["CRACK_BAND=16 J/m2"]),

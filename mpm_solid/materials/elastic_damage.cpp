@@ -67,20 +67,38 @@ ElasticDamage::ElasticDamage(std::string name, Elasticity elasticity, DamagePara
   ucs_ = 2 * damage.cohesion * cos_phi_ / (1 - sin_phi_);
 }
 
+namespace {
+
+// splitmix64's finaliser (Steele, Lea & Flood 2014).
+std::uint64_t mix(std::uint64_t z) {
+  z += 0x9e3779b97f4a7c15ULL;
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  return z ^ (z >> 31);
+}
+
+// Inverse of F(u) = 1 - exp(-(u / u0)^m) at the uniform draw in [0, 1) that
+// `bits` carry, with u0 = 1 / Gamma(1 + 1/m) for a mean of 1.
+double weibull(double m, std::uint64_t bits) {
+  const double uniform = static_cast<double>(bits >> 11) * 0x1p-53;
+  const double u0 = 1 / std::tgamma(1 + 1 / m);
+  return u0 * std::pow(-std::log1p(-uniform), 1 / m);
+}
+
+std::uint64_t strength_bits(const DamageParameters::Heterogeneity& h, std::int64_t id) {
+  return mix(h.seed ^ mix(static_cast<std::uint64_t>(id)));
+}
+
+}  // namespace
+
 double weibull_strength_scale(const DamageParameters::Heterogeneity& h, std::int64_t id) {
-  // splitmix64 (Steele, Lea & Flood 2014) of the seed and the id: a uniform
-  // draw in [0, 1) that depends on nothing else.
-  const auto mix = [](std::uint64_t z) {
-    z += 0x9e3779b97f4a7c15ULL;
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    return z ^ (z >> 31);
-  };
-  const double uniform = static_cast<double>(mix(h.seed ^ mix(static_cast<std::uint64_t>(id))) >> 11) * 0x1p-53;
-  // Inverse of F(u) = 1 - exp(-(u / u0)^m), with u0 = 1 / Gamma(1 + 1/m) for
-  // a mean of 1.
-  const double u0 = 1 / std::tgamma(1 + 1 / h.homogeneity_index);
-  return u0 * std::pow(-std::log1p(-uniform), 1 / h.homogeneity_index);
+  return weibull(h.homogeneity_index, strength_bits(h, id));
+}
+
+double weibull_modulus_scale(const DamageParameters::Heterogeneity& h, std::int64_t id) {
+  // The next value of the strength's stream: independent of it, and of the
+  // seed and the id alone.
+  return weibull(h.modulus_index(), mix(strength_bits(h, id)));
 }
 
 void ElasticDamage::create_fields(Particles<2>& p, const std::vector<int>& members) const {
@@ -88,12 +106,16 @@ void ElasticDamage::create_fields(Particles<2>& p, const std::vector<int>& membe
   p.need_damage();
   if (!parameters_.heterogeneity) return;
   p.need("heterogeneity");
-  for (const int i : members) p.strength_scale[i] = weibull_strength_scale(*parameters_.heterogeneity, p.id[i]);
+  for (const int i : members) {
+    p.strength_scale[i] = weibull_strength_scale(*parameters_.heterogeneity, p.id[i]);
+    p.modulus_scale[i] = weibull_modulus_scale(*parameters_.heterogeneity, p.id[i]);
+  }
 }
 
-double ElasticDamage::damage(double previous, const Mat<2>& effective, double effective_zz, double scale) const {
+double ElasticDamage::damage(double previous, const Mat<2>& effective, double effective_zz, double scale,
+                            double stiffness) const {
   const auto& d = parameters_;
-  const double e0 = elasticity().youngs_modulus, nu = elasticity().poisson_ratio;
+  const double e0 = stiffness * elasticity().youngs_modulus, nu = elasticity().poisson_ratio;
   const Principal pr = principal(effective);
   const double s1 = std::max(pr.a, effective_zz), s3 = std::min(pr.b, effective_zz);
   const double s2 = pr.a + pr.b + effective_zz - s1 - s3;
@@ -109,7 +131,7 @@ double ElasticDamage::damage(double previous, const Mat<2>& effective, double ef
     // sides. (In E0 eps_1, the paper's form carries (lambda + 2G) / E0 times
     // more under lateral constraint, and a fixed onset f_t / E0 adds a plateau
     // at f_t: both make the band dissipate more.)
-    const double ultimate = scale * ultimate_strain_;
+    const double ultimate = scale / stiffness * ultimate_strain_;
     double tensile = 1.0;
     if (eps1 < ultimate) {
       if (!d.fracture_energy) {
@@ -130,16 +152,19 @@ double ElasticDamage::damage(double previous, const Mat<2>& effective, double ef
 }
 
 Dissipation ElasticDamage::update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const {
-  const double g = elasticity().shear_modulus(), bulk = elasticity().lame_lambda() + 2.0 / 3.0 * g;
+  const double g0 = elasticity().shear_modulus(), bulk0 = elasticity().lame_lambda() + 2.0 / 3.0 * g0;
   const bool heterogeneous = parameters_.heterogeneity.has_value();
   return each_member(p, members, dt, [&](int i) {
     Dissipation dissipated;
     Mat<2>& effective = p.effective_stress[i];
     double& effective_zz = p.effective_stress_zz[i];
-    elastic_trial(elasticity(), p.velocity_gradient[i], dt, effective, effective_zz);
-    const double previous = p.damage[i];
     const double scale = heterogeneous ? p.strength_scale[i] : 1.0;
-    const double d = damage(previous, effective, effective_zz, scale);
+    const double stiffness = heterogeneous ? p.modulus_scale[i] : 1.0;
+    Elasticity own = elasticity();
+    own.youngs_modulus *= stiffness;  // lambda and G scale with E
+    elastic_trial(own, p.velocity_gradient[i], dt, effective, effective_zz);
+    const double previous = p.damage[i];
+    const double d = damage(previous, effective, effective_zz, scale, stiffness);
     p.damage[i] = d;
     // The stress acting: open cracks carry no share of tension.
     const Principal pr = principal(effective);
@@ -151,15 +176,18 @@ Dissipation ElasticDamage::update_stress(Particles<2>& p, const std::vector<int>
       const double before_zz = crack(effective_zz, 1 - previous);
       dissipated.damage = 0.5 * p.volume[i] *
                           (compliance_product(before, before_zz, effective, effective_zz) -
-                           compliance_product(s, s_zz, effective, effective_zz));
+                           compliance_product(s, s_zz, effective, effective_zz)) /
+                          stiffness;
     }
     // Friction bounds compressive states, with the cohesion the cracks leave;
     // tension is the damage law's to soften (a cone there would cap the elastic
     // strain the damage is read from).
     double work = 0;
     const bool compressive = s.trace() + s_zz < 0;
-    if (const double multiplier =
-            compressive ? drucker_prager_return(alpha_, (1 - d) * scale * k0_, 0.0, g, bulk, s, s_zz, &work) : 0.0;
+    if (const double multiplier = compressive ? drucker_prager_return(alpha_, (1 - d) * scale * k0_, 0.0,
+                                                                      stiffness * g0, stiffness * bulk0, s, s_zz,
+                                                                      &work)
+                                              : 0.0;
         multiplier > 0) {
       p.plastic_strain[i] += multiplier / std::sqrt(3.0);  // no dilation: sqrt(2/3 |dg/dsigma|^2) = 1/sqrt(3)
       dissipated.plastic = p.volume[i] * work;
@@ -177,9 +205,11 @@ Dissipation ElasticDamage::update_stress(Particles<2>& p, const std::vector<int>
 }
 
 double ElasticDamage::strain_energy(const Particles<2>& p, const std::vector<int>& members) const {
+  const bool heterogeneous = parameters_.heterogeneity.has_value();
   return sum_over(members, [&](int i) {
     return 0.5 * p.volume[i] *
-           compliance_product(p.stress[i], p.stress_zz[i], p.effective_stress[i], p.effective_stress_zz[i]);
+           compliance_product(p.stress[i], p.stress_zz[i], p.effective_stress[i], p.effective_stress_zz[i]) /
+           (heterogeneous ? p.modulus_scale[i] : 1.0);
   });
 }
 
@@ -232,14 +262,21 @@ std::unique_ptr<Material> read(const scene::Table& m, const MaterialContext& c) 
                                                  "broken coal bulks to a loose heap, its fragments then part "
                                                  "(1.3-1.6 is typical of broken coal)",
                                "1.5", Range::at_least(1)});
-  if (const auto h = m.table("heterogeneity", "heterogeneous coal: each particle's strengths scaled by a Weibull "
-                                               "draw of mean 1 (RFPA's approach)", false)) {
+  if (const auto h = m.table("heterogeneity", "heterogeneous coal: each particle's strengths and moduli scaled by "
+                                               "Weibull draws of mean 1 (RFPA's approach)", false)) {
+    const double index = h->number({"homogeneity_index", "Weibull shape m of the strengths: the larger, the more "
+                                                         "uniform the coal (1.5-5 is typical of RFPA models of coal "
+                                                         "and rock)",
+                                    "", Range::at_least(1)});
+    const std::string same_as_strength = fmt::format("{:.17g}", index);
     d.heterogeneity = DamageParameters::Heterogeneity{
-        h->number({"homogeneity_index", "Weibull shape m: the larger, the more uniform the coal (1.5-5 is "
-                                        "typical of RFPA models of coal and rock)",
-                   "", Range::at_least(1)}),
+        index,
         static_cast<std::uint64_t>(h->integer<std::int64_t>(
-            {"seed", "seed of the draw: the same seed, the same coal", "1", Range::non_negative()}))};
+            {"seed", "seed of the draw: the same seed, the same coal", "1", Range::non_negative()})),
+        h->number({"modulus_homogeneity_index", "Weibull shape m_E of the elastic moduli, drawn apart from the "
+                                                "strengths (default: the homogeneity_index); the stiffest particle "
+                                                "sets the stable step",
+                   same_as_strength, Range::at_least(1)})};
   }
   return std::make_unique<ElasticDamage>(c.name, c.elasticity, d);
 }

@@ -48,22 +48,28 @@ struct DamageParameters {
   // recontact) with it, and the stable step shrinks without bound.
   double bulking_factor = 1.5;
   // Heterogeneous coal (RFPA's approach: Tang 1997; Xu, Tang et al. 2006): each
-  // particle's strengths f_t and c, and its ultimate strain, scaled by a factor
-  // drawn from a Weibull distribution of shape m (the homogeneity index) and
-  // mean 1. The draw is a hash of the seed and the particle's id: the same
+  // particle's strengths f_t and c scaled by a factor s_f, and its elastic
+  // moduli by a factor s_E, drawn independently from Weibull distributions of
+  // mean 1 and shapes m and m_E (the homogeneity indices; m_E = m unless
+  // given). The draws are hashes of the seed and the particle's id: the same
   // seed gives the same coal whatever the threads or the particle order.
-  // Under a crack band G_f scales with the square of the factor, so every
-  // particle keeps the characteristic length E G_f / f_t^2 and the band's
-  // snap-back limit holds for all alike.
+  // The ultimate strain scales as the strain at f_t does, by s_f / s_E; under
+  // a crack band G_f then scales by s_f^2 / s_E, so every particle keeps the
+  // characteristic length E G_f / f_t^2 and the band's snap-back limit holds
+  // for all alike.
   struct Heterogeneity {
     double homogeneity_index;
     std::uint64_t seed;
+    std::optional<double> modulus_homogeneity_index = std::nullopt;
+    double modulus_index() const { return modulus_homogeneity_index.value_or(homogeneity_index); }
   };
   std::optional<Heterogeneity> heterogeneity = std::nullopt;
 };
 
-// The strength factor of particle `id`: Weibull with shape m, mean 1.
+// The factors of particle `id` on the strengths and on the moduli: Weibull,
+// mean 1, drawn independently of each other.
 double weibull_strength_scale(const DamageParameters::Heterogeneity& h, std::int64_t id);
+double weibull_modulus_scale(const DamageParameters::Heterogeneity& h, std::int64_t id);
 
 // The widest crack band a fracture energy allows with elasticity e: the one
 // whose peak alone, f_t^2 / (2 E0) per unit volume, dissipates G_f [m]
@@ -76,8 +82,9 @@ class ElasticDamage final : public Material {
   void create_fields(Particles<2>& p, const std::vector<int>& members) const override;
   Dissipation update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const override;
   // Damage of one particle, given its history value, effective stress and
-  // strength factor.
-  double damage(double previous, const Mat<2>& effective, double effective_zz, double scale = 1.0) const;
+  // factors on the strengths and the moduli.
+  double damage(double previous, const Mat<2>& effective, double effective_zz, double scale = 1.0,
+                double stiffness = 1.0) const;
   const DamageParameters& parameters() const { return parameters_; }
   double strain_energy(const Particles<2>& p, const std::vector<int>& members) const override;
 
