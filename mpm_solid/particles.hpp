@@ -48,6 +48,9 @@ struct Particles {
   // moduli, drawn per particle (1 elsewhere).
   std::vector<double> strength_scale;
   std::vector<double> modulus_scale;
+  // The damage-driving strain over the strain at f_t, averaged over a
+  // material's internal length (nonlocal damage).
+  std::vector<double> nonlocal_strain;
 
   // The field table: every field above once, with its checkpoint name and,
   // for an optional one, the effect that creates it and the field it starts
@@ -93,7 +96,9 @@ struct Particles {
         Field<double>{.name = "strength_scale", .values = &P::strength_scale, .effect = "heterogeneity",
                       .fill = 1.0, .written = Written::when_present},
         Field<double>{.name = "modulus_scale", .values = &P::modulus_scale, .effect = "heterogeneity",
-                      .fill = 1.0, .written = Written::when_present});
+                      .fill = 1.0, .written = Written::when_present},
+        Field<double>{.name = "nonlocal_strain", .values = &P::nonlocal_strain, .effect = "nonlocal damage",
+                      .written = Written::when_present});
   }
   template <class F>
   void for_each_field(F&& f) {

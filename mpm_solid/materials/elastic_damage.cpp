@@ -9,6 +9,8 @@
 
 #include <fmt/format.h>
 
+#include "mpm_solid/nonlocal.hpp"
+
 namespace outburst::mpm {
 
 namespace {
@@ -104,6 +106,7 @@ double weibull_modulus_scale(const DamageParameters::Heterogeneity& h, std::int6
 void ElasticDamage::create_fields(Particles<2>& p, const std::vector<int>& members) const {
   p.need_plastic_strain();
   p.need_damage();
+  if (parameters_.internal_length) p.need("nonlocal damage");
   if (!parameters_.heterogeneity) return;
   p.need("heterogeneity");
   for (const int i : members) {
@@ -112,17 +115,34 @@ void ElasticDamage::create_fields(Particles<2>& p, const std::vector<int>& membe
   }
 }
 
-double ElasticDamage::damage(double previous, const Mat<2>& effective, double effective_zz, double scale,
-                            double stiffness) const {
-  const auto& d = parameters_;
+struct ElasticDamage::Stresses {
+  double s1, s2, s3;    // s1 >= s2 >= s3, out-of-plane included
+  double eps1, eps3;    // the strains along s1 and s3
+};
+
+ElasticDamage::Stresses ElasticDamage::principal_stresses(const Mat<2>& effective, double effective_zz,
+                                                          double stiffness) const {
   const double e0 = stiffness * elasticity().youngs_modulus, nu = elasticity().poisson_ratio;
   const Principal pr = principal(effective);
   const double s1 = std::max(pr.a, effective_zz), s3 = std::min(pr.b, effective_zz);
   const double s2 = pr.a + pr.b + effective_zz - s1 - s3;
-  const auto strain = [&](double si, double sj, double sk) { return (si - nu * (sj + sk)) / e0; };
+  return {s1, s2, s3, (s1 - nu * (s2 + s3)) / e0, (s3 - nu * (s1 + s2)) / e0};
+}
+
+double ElasticDamage::shear_damage(const Stresses& s, double scale, double stiffness) const {
+  const auto& d = parameters_;
+  if (0.5 * (s.s1 - s.s3) < scale * d.cohesion * cos_phi_ - 0.5 * (s.s1 + s.s3) * sin_phi_ || s.eps3 >= 0) return 0;
+  return 1 - d.residual_ratio * scale * ucs_ / (stiffness * elasticity().youngs_modulus * -s.eps3);
+}
+
+double ElasticDamage::damage(double previous, const Mat<2>& effective, double effective_zz, double scale,
+                             double stiffness) const {
+  const auto& d = parameters_;
+  const double e0 = stiffness * elasticity().youngs_modulus;
+  const Stresses st = principal_stresses(effective, effective_zz, stiffness);
+  const double s1 = st.s1, eps1 = st.eps1;
   double damage = previous;
   if (s1 >= scale * d.tensile_strength) {
-    const double eps1 = strain(s1, s2, s3);
     // The paper's law keeps the residual share of E0 eps_1. A crack band
     // instead carries a share of f_t that falls linearly in eps_1 from the
     // onset, the strain at which this stress state reached f_t (eps_1 f_t /
@@ -144,27 +164,40 @@ double ElasticDamage::damage(double previous, const Mat<2>& effective, double ef
     }
     damage = std::max(damage, tensile);
   }
-  if (0.5 * (s1 - s3) >= scale * d.cohesion * cos_phi_ - 0.5 * (s1 + s3) * sin_phi_) {
-    const double eps3 = strain(s3, s1, s2);
-    if (eps3 < 0) damage = std::max(damage, 1 - d.residual_ratio * scale * ucs_ / (e0 * -eps3));
-  }
-  return std::clamp(damage, 0.0, 1.0);
+  return std::clamp(std::max(damage, shear_damage(st, scale, stiffness)), 0.0, 1.0);
+}
+
+double ElasticDamage::driving_strain(const Mat<2>& effective, double effective_zz, double scale,
+                                     double stiffness) const {
+  const double at_strength = scale * parameters_.tensile_strength / (stiffness * elasticity().youngs_modulus);
+  return std::clamp(principal_stresses(effective, effective_zz, stiffness).eps1 / at_strength, 0.0,
+                    parameters_.ultimate_ratio);
+}
+
+double ElasticDamage::nonlocal_tensile_damage(double averaged) const {
+  const double eta = parameters_.ultimate_ratio;
+  if (averaged <= 1) return 0;
+  if (averaged >= eta) return 1;
+  return 1 - (eta - averaged) / ((eta - 1) * averaged);
 }
 
 Dissipation ElasticDamage::update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const {
   const double g0 = elasticity().shear_modulus(), bulk0 = elasticity().lame_lambda() + 2.0 / 3.0 * g0;
   const bool heterogeneous = parameters_.heterogeneity.has_value();
-  return each_member(p, members, dt, [&](int i) {
+  const auto scale = [&](int i) { return heterogeneous ? p.strength_scale[i] : 1.0; };
+  const auto stiffness = [&](int i) { return heterogeneous ? p.modulus_scale[i] : 1.0; };
+  const auto trial = [&](int i) {
+    Elasticity own = elasticity();
+    own.youngs_modulus *= stiffness(i);  // lambda and G scale with E
+    elastic_trial(own, p.velocity_gradient[i], dt, p.effective_stress[i], p.effective_stress_zz[i]);
+  };
+  // The acting stress at damage d, what the growth of damage took, and the
+  // friction of compressive states.
+  const auto settle = [&](int i, double d) {
     Dissipation dissipated;
     Mat<2>& effective = p.effective_stress[i];
     double& effective_zz = p.effective_stress_zz[i];
-    const double scale = heterogeneous ? p.strength_scale[i] : 1.0;
-    const double stiffness = heterogeneous ? p.modulus_scale[i] : 1.0;
-    Elasticity own = elasticity();
-    own.youngs_modulus *= stiffness;  // lambda and G scale with E
-    elastic_trial(own, p.velocity_gradient[i], dt, effective, effective_zz);
     const double previous = p.damage[i];
-    const double d = damage(previous, effective, effective_zz, scale, stiffness);
     p.damage[i] = d;
     // The stress acting: open cracks carry no share of tension.
     const Principal pr = principal(effective);
@@ -177,16 +210,16 @@ Dissipation ElasticDamage::update_stress(Particles<2>& p, const std::vector<int>
       dissipated.damage = 0.5 * p.volume[i] *
                           (compliance_product(before, before_zz, effective, effective_zz) -
                            compliance_product(s, s_zz, effective, effective_zz)) /
-                          stiffness;
+                          stiffness(i);
     }
     // Friction bounds compressive states, with the cohesion the cracks leave;
     // tension is the damage law's to soften (a cone there would cap the elastic
     // strain the damage is read from).
     double work = 0;
     const bool compressive = s.trace() + s_zz < 0;
-    if (const double multiplier = compressive ? drucker_prager_return(alpha_, (1 - d) * scale * k0_, 0.0,
-                                                                      stiffness * g0, stiffness * bulk0, s, s_zz,
-                                                                      &work)
+    if (const double multiplier = compressive ? drucker_prager_return(alpha_, (1 - d) * scale(i) * k0_, 0.0,
+                                                                      stiffness(i) * g0, stiffness(i) * bulk0, s,
+                                                                      s_zz, &work)
                                               : 0.0;
         multiplier > 0) {
       p.plastic_strain[i] += multiplier / std::sqrt(3.0);  // no dilation: sqrt(2/3 |dg/dsigma|^2) = 1/sqrt(3)
@@ -201,7 +234,41 @@ Dissipation ElasticDamage::update_stress(Particles<2>& p, const std::vector<int>
     p.stress_zz[i] = s_zz;
     if (d >= 1) p.volume[i] = std::min(p.volume[i], parameters_.bulking_factor * p.volume0[i]);
     return dissipated;
+  };
+  if (!parameters_.internal_length)
+    return each_member(p, members, dt, [&](int i) {
+      trial(i);
+      return settle(i, damage(p.damage[i], p.effective_stress[i], p.effective_stress_zz[i], scale(i), stiffness(i)));
+    });
+  // Nonlocal: every member's trial stress and driving strain first, then
+  // their averages over the internal length, then the damage.
+  each_member(p, members, dt, [&](int i) {
+    trial(i);
+    p.nonlocal_strain[i] = driving_strain(p.effective_stress[i], p.effective_stress_zz[i], scale(i), stiffness(i));
+    return Dissipation{};
   });
+  std::vector<double> local(members.size()), weight(members.size());
+  for (std::size_t k = 0; k < members.size(); ++k) {
+    const int i = members[k];
+    local[k] = p.nonlocal_strain[i];
+    weight[k] = p.damage[i] < 1 ? p.volume[i] : 0.0;
+  }
+  const std::vector<double> averaged = nonlocal_average(p.x, members, weight, local, *parameters_.internal_length);
+  const int n = static_cast<int>(members.size());
+  double plastic = 0, damaged = 0;
+#pragma omp parallel for schedule(static) reduction(+ : plastic, damaged)
+  for (int k = 0; k < n; ++k) {
+    const int i = members[k];
+    p.nonlocal_strain[i] = averaged[k];
+    const Stresses st = principal_stresses(p.effective_stress[i], p.effective_stress_zz[i], stiffness(i));
+    const double d = std::clamp(std::max({p.damage[i], nonlocal_tensile_damage(averaged[k]),
+                                          shear_damage(st, scale(i), stiffness(i))}),
+                                0.0, 1.0);
+    const Dissipation r = settle(i, d);
+    plastic += r.plastic;
+    damaged += r.damage;
+  }
+  return {plastic, damaged};
 }
 
 double ElasticDamage::strain_energy(const Particles<2>& p, const std::vector<int>& members) const {
@@ -257,6 +324,23 @@ std::unique_ptr<Material> read(const scene::Table& m, const MaterialContext& c) 
                                                           "which D = 1 (the paper gives none; 5-10 is common); "
                                                           "or give a fracture_energy",
                                  "5", Range::at_least(1)});
+  }
+  if (m.has("internal_length")) {
+    if (d.fracture_energy)
+      m.fail("internal_length", "give a fracture_energy (a crack band) or an internal_length (nonlocal damage), "
+                                "not both");
+    d.internal_length = m.quantity({"internal_length", "R, radius over which nonlocal damage averages its driving "
+                                                       "strain (a bell-shaped weight): the crack spreads over a zone "
+                                                       "about R wide, softening linearly to nothing at eta",
+                                    "", Range::positive()},
+                                   units::length);
+    // Fewer than two cells across R: too few particles to average over, and
+    // the zone would follow the cell again.
+    if (*d.internal_length < 2 * c.cell_size)
+      m.refuse("internal_length",
+               fmt::format("an internal length of {:g} m is not resolved by cells of {:g} m: refine "
+                           "mpm.grid.cell_size to at most R / 2 = {:.4g} m, or lengthen R",
+                           *d.internal_length, c.cell_size, *d.internal_length / 2));
   }
   d.bulking_factor = m.number({"bulking_factor", "largest volume of fully damaged coal over its volume at t = 0: "
                                                  "broken coal bulks to a loose heap, its fragments then part "

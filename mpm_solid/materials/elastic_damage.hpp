@@ -41,6 +41,19 @@ struct DamageParameters {
   // compression) breaks at once.
   std::optional<double> fracture_energy;
   double band_width = 0;
+  // Nonlocal damage (Pijaudier-Cabot & Bazant 1987), the other regularised
+  // law: tensile damage is driven by the largest principal strain over the
+  // particle's strain at f_t, eps_1 E0 / f_t, averaged over the particles
+  // within the internal length R [m] (mpm_solid/nonlocal.hpp), and softens
+  // linearly in that average from f_t at 1 to nothing at eta:
+  // D = 1 - (eta - e) / ((eta - 1) e). The crack then spreads over a zone
+  // about as wide as R whatever the cell, so the energy it takes converges as
+  // the cells shrink. A point weighs in its neighbours' averages by its
+  // volume times (1 - D), and its own value is capped at eta: a crack ends the
+  // interaction across it (Geers et al. 1998 let it fade likewise), where the
+  // opening of broken points would otherwise drive their neighbours' damage
+  // on and the zone would spread without end. Shear damage stays local.
+  std::optional<double> internal_length = std::nullopt;
   // Largest volume of fully damaged material over its initial volume. Broken
   // coal bulks to a loose heap; beyond that its fragments part and the gaps are
   // no part of any particle. Without the cap a fragment's volume grows with
@@ -85,6 +98,8 @@ class ElasticDamage final : public Material {
   // factors on the strengths and the moduli.
   double damage(double previous, const Mat<2>& effective, double effective_zz, double scale = 1.0,
                 double stiffness = 1.0) const;
+  // Tensile damage of nonlocal damage from the averaged driving strain.
+  double nonlocal_tensile_damage(double averaged) const;
   const DamageParameters& parameters() const { return parameters_; }
   double strain_energy(const Particles<2>& p, const std::vector<int>& members) const override;
 
@@ -93,6 +108,13 @@ class ElasticDamage final : public Material {
   double ultimate_strain_;  // eps_tu: from eta, or from G_f and the band width
   double alpha_, k0_;       // Drucker-Prager friction cone (outer fit), intact cohesion
   double sin_phi_, cos_phi_, ucs_;  // of the Mohr-Coulomb shear criterion
+
+  struct Stresses;  // ordered principal stresses, with the strains they hold
+  Stresses principal_stresses(const Mat<2>& effective, double effective_zz, double stiffness) const;
+  double shear_damage(const Stresses& s, double scale, double stiffness) const;
+  // The local driver of nonlocal damage: eps_1 over the strain at f_t, in
+  // [0, eta].
+  double driving_strain(const Mat<2>& effective, double effective_zz, double scale, double stiffness) const;
 };
 
 }  // namespace outburst::mpm

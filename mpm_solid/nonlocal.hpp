@@ -1,0 +1,25 @@
+#pragma once
+// Nonlocal averages over material points, for damage with an internal length
+// (Pijaudier-Cabot & Bazant 1987; the bell-shaped weight of Bazant & Jirasek
+// 2002): a particle's value is replaced by the mean of its neighbours' values
+// within the radius R, each weighted by its own weight (its volume, or less)
+// times (1 - r^2 / R^2)^2. The weights are normalised by their sum, so a
+// uniform field stays uniform at a free surface, where a particle has fewer
+// neighbours.
+
+#include <vector>
+
+#include "mpm_solid/grid.hpp"
+
+namespace outburst::mpm {
+
+// The averages of value[k], the value of particle members[k] of weight
+// weight[k], over the members within `radius` of it [m] (itself included; its
+// own value where every weight within R is zero); x is indexed by particle.
+// O(n log n + n neighbours): the members are binned into squares of side R by
+// a sort, so a particle far from the rest costs no empty bins.
+std::vector<double> nonlocal_average(const std::vector<Vec<2>>& x, const std::vector<int>& members,
+                                     const std::vector<double>& weight, const std::vector<double>& value,
+                                     double radius);
+
+}  // namespace outburst::mpm
