@@ -2,7 +2,9 @@
 // The bilinear quadrilateral (Q1): shape functions on the reference square
 // [-1, 1]^2, the isoparametric map, and the element integrals the solver needs.
 
+#include <algorithm>
 #include <array>
+#include <limits>
 #include <optional>
 
 #include <Eigen/Core>
@@ -87,6 +89,17 @@ inline Integrals integrals(const Corners& x) {
 // Reference coordinates of `point` in the cell, or nullopt if it lies outside
 // (with a small tolerance so points on shared edges are found).
 inline std::optional<Eigen::Vector2d> inverse_map(const Corners& x, const Eigen::Vector2d& point) {
+  // Newton has converged once its step is at the roundoff of the coordinates:
+  // about eps |x| in space, eps |x| / (cell size) in reference coordinates.
+  // For a small cell far from the origin that lies above any fixed bound (a
+  // cell of 1/8 m at x = 40 m: 1.4e-13), and a bound below it missed every
+  // point of the cell.
+  double reach = 0, size = 0;
+  for (int a = 0; a < 4; ++a) {
+    reach = std::max(reach, x[a].lpNorm<Eigen::Infinity>());
+    size = std::max(size, (x[a] - x[0]).lpNorm<Eigen::Infinity>());
+  }
+  const double tolerance = std::max(1e-13, 64 * std::numeric_limits<double>::epsilon() * reach / size);
   Eigen::Vector2d ref = Eigen::Vector2d::Zero();
   bool converged = false;
   for (int it = 0; it < 30; ++it) {
@@ -100,7 +113,7 @@ inline std::optional<Eigen::Vector2d> inverse_map(const Corners& x, const Eigen:
     }
     const Eigen::Vector2d step = jac.inverse() * (point - mapped);
     ref += step;
-    if (step.lpNorm<Eigen::Infinity>() < 1e-13) {
+    if (step.lpNorm<Eigen::Infinity>() < tolerance) {
       converged = true;
       break;
     }

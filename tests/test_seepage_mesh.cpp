@@ -159,3 +159,34 @@ TEST_CASE("a locator over a very thin mesh has no more buckets than cells", "[se
   CHECK(locator.buckets() <= m.num_cells());
   REQUIRE(locator.locate({15, 1e-22}));
 }
+
+TEST_CASE("points are located in small cells far from the origin", "[seepage][mesh]") {
+  // Found by the outburst's convergence study: Newton's step in reference
+  // coordinates had to fall below 1e-13, under its own roundoff (eps |x| /
+  // cell) in cells of 1/8 m beyond x = 32 m, so their particles lay in no cell:
+  // no pore pressure, and the cells read as open space.
+  const double cell = GENERATE(0.125, 1.0 / 6, 0.01);
+  const double far = GENERATE(45.0, 1e3, -2e3);
+  StructuredMeshSpec spec;
+  spec.origin = {far, -far};
+  spec.size = {40 * cell, 20 * cell};
+  spec.cells = {40, 20};
+  spec.regions = {{"all", true, {}, {}}};
+  const Mesh m = make_structured_mesh(spec);
+  const CellLocator locator(m);
+  int found = 0, points = 0;
+  for (int i = 0; i < 160; ++i)
+    for (int j = 0; j < 80; ++j, ++points) {
+      const Eigen::Vector2d x = spec.origin + cell * Eigen::Vector2d((i + 0.5) / 4, (j + 0.5) / 4);
+      const auto hit = locator.locate(x);
+      if (!hit) continue;
+      ++found;
+      const auto& c = m.cells[hit->cell];
+      const auto n = q1::shape(hit->reference.x(), hit->reference.y());
+      Eigen::Vector2d back = Eigen::Vector2d::Zero();
+      for (int a = 0; a < 4; ++a) back += n[a] * m.nodes[c[a]];
+      CHECK((back - x).norm() < 1e-9 * cell + 1e-13 * std::abs(far));
+    }
+  INFO("cells of " << cell << " m at " << far << " m");
+  CHECK(found == points);
+}
