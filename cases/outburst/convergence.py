@@ -5,15 +5,21 @@ outburst-prone coal.
 
 usage: python3 -m cases.outburst.convergence [--outburst build/coupler/outburst] [--out results/outburst_convergence]
                                               [--cells 1/2 1/3 1/4 1/6 1/8] [--laws local crack_band]
-                                              [--end-time "1 s"] [--resume | --measure-only]
+                                              [--end-time "1 s"] [--at 0.5 1] [--resume | --measure-only]
+                                              [--seeds N [--homogeneity 3] [--jobs J]]
 writes OUT/convergence.csv (a row per law, cell and time measured at),
 OUT/convergence.md (the headline numbers and the change between the two finest
 cells) and OUT/convergence.png; one run at a time, each on every core (the
 finest, 1/8 m, takes 20-25 minutes to 1 s on 2 cores; the whole study about an
 hour and a half). Each finished run is kept in its folder (run.json): --resume
 measures those instead of running them again, --measure-only runs nothing.
+With --seeds N the coal is heterogeneous (mpm_solid/README.md, Heterogeneous
+coal): N seeds at each cell, J side by side, and OUT/convergence_ensemble.csv
+and .md give each quantity's mean and 95 % interval by cell, and whether the
+two finest cells' means agree within their intervals.
 """
 import argparse
+import concurrent.futures
 import json
 import os
 from fractions import Fraction
@@ -104,6 +110,65 @@ def write(rows, laws, times, out):
     return lines
 
 
+def kept_or_run(args, law, scene, overrides, run_dir, label, threads):
+    """One run of the study: the one kept in run_dir (with --resume or
+    --measure-only, if made with the same scene and overrides), or a new one;
+    None if --measure-only finds none."""
+    os.makedirs(run_dir, exist_ok=True)
+    kept = os.path.join(run_dir, "run.json")
+    if (args.resume or args.measure_only) and os.path.exists(kept):
+        with open(kept) as f:
+            run = json.load(f)
+        if run["overrides"] == overrides and run["law"] == law and run.get("scene") == scene:
+            print(f"{law}, {label}: kept from {run_dir}", flush=True)
+            return run
+    if args.measure_only:
+        return None
+    wall, failure = run_one(args.outburst, scene, overrides, run_dir, threads)
+    run = {"law": law, "scene": scene, "overrides": overrides, "wall_s": wall, "failure": failure}
+    with open(kept, "w") as f:
+        json.dump(run, f)
+    return run
+
+
+def measured(run, run_dir, row, times):
+    """The rows of one run: one per time measured at, or its failure."""
+    if run is None:
+        return [row | {"failure": "not run (--measure-only)"}]
+    row = row | {"wall_s": run["wall_s"]}
+    if run["failure"]:
+        return [row | {"failure": run["failure"]}]
+    particles = len(Run(run_dir).particles(0)["points"])
+    return [row | {"time_s": time, "particles": particles} | headline(run_dir, time) for time in times]
+
+
+def ensemble_table(rows, law, time, homogeneity):
+    """Markdown: each quantity's mean and 95 % interval over the seeds, by cell,
+    and whether the two finest cells' means agree within their intervals."""
+    from .ensemble import summary
+    cells = list(dict.fromkeys(r["cell"] for r in rows if r["law"] == law))
+    lines = [f"### {law.replace('_', ' ')}, heterogeneous coal (m = {homogeneity:g}), t = {time:g} s", "",
+             "| quantity | " + " | ".join(f"{c} (seeds)" for c in cells) +
+             (" | two finest agree within their intervals |" if len(cells) > 1 else " |"),
+             "|---|" + "---|" * len(cells) + ("---|" if len(cells) > 1 else "")]
+    for key, label in QUANTITIES:
+        stats = []
+        for c in cells:
+            values = [r[key] for r in rows if r["law"] == law and r["cell"] == c and not r.get("failure")
+                      and r["time_s"] == time]
+            stats.append(summary(values) + (len(values),) if values else None)
+        line = f"| {label} | " + " | ".join(f"{m:.3g} +- {h:.2g} ({n})" if st else "-"
+                                            for st in stats for m, _, h, n in [st or (0, 0, 0, 0)])
+        if len(cells) > 1:
+            a, b = stats[-2], stats[-1]
+            line += " | " + ("-" if not (a and b) else "yes" if abs(a[0] - b[0]) <= a[2] + b[2] else
+                             f"no: {abs(a[0] - b[0]):.3g} apart")
+        lines.append(line + " |")
+    failed = [r for r in rows if r["law"] == law and r.get("failure")]
+    lines += [f"\n{r['cell']}, seed {r['seed']}: {r['failure']}" for r in failed]
+    return lines
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--outburst", default="build/coupler/outburst")
@@ -114,49 +179,61 @@ def main():
     ap.add_argument("--end-time", default="1 s")
     ap.add_argument("--at", nargs="+", type=float, default=[0.5, 1.0],
                     help="times [s] the headline numbers are measured at (multiples of 0.1 s, up to the end)")
+    ap.add_argument("--seeds", type=int, default=0,
+                    help="heterogeneous coal: an ensemble of this many seeds at each cell (0: uniform coal)")
+    ap.add_argument("--homogeneity", type=float, default=3.0, help="the ensembles' Weibull shape m")
+    ap.add_argument("--jobs", type=int, default=1, help="an ensemble's runs side by side (cores / jobs threads each)")
     ap.add_argument("--resume", action="store_true", help="keep the runs an earlier study finished")
     ap.add_argument("--measure-only", action="store_true",
                     help="run nothing: measure the runs an earlier study finished, and list the others as not run")
     args = ap.parse_args()
+    if args.seeds < 0 or args.homogeneity < 1 or args.jobs < 1:
+        ap.error("--seeds must be at least 0, --homogeneity and --jobs at least 1")
     os.makedirs(args.out, exist_ok=True)
     cells = [Fraction(c) for c in args.cells]
+    cores = os.cpu_count() or 1
+    jobs = min(args.jobs, cores, max(args.seeds, 1))
+    threads = max(1, cores // jobs)
     rows = []
     for law in args.laws:
         scene = scene_for(law, args.out)
         for cell in cells:
             label = f"{cell} m"
-            run_dir = os.path.join(args.out, f"{law}_{cell.numerator}_{cell.denominator}")
+            name = f"{law}_{cell.numerator}_{cell.denominator}"
             overrides = [f'scene.end_time="{args.end_time}"', f'mpm.grid.cell_size="{float(cell)!r} m"',
                          f'seepage.mesh.file="{seam_mesh(args.out, cell, f"seam_{cell.numerator}_{cell.denominator}.msh")}"', 'output.interval="0.1 s"']
-            os.makedirs(run_dir, exist_ok=True)
-            kept = os.path.join(run_dir, "run.json")
-            run = None
-            if (args.resume or args.measure_only) and os.path.exists(kept):
-                with open(kept) as f:
-                    run = json.load(f)
-                if run["overrides"] != overrides or run["law"] != law or run.get("scene") != scene:
-                    run = None
-                else:
-                    print(f"{law}, {label}: kept from {run_dir}", flush=True)
-            if run is None and args.measure_only:
-                rows.append({"law": law, "cell": label, "wall_s": 0.0, "failure": "not run (--measure-only)"})
+            row = {"law": law, "cell": label}
+            if not args.seeds:
+                run_dir = os.path.join(args.out, name)
+                rows += measured(kept_or_run(args, law, scene, overrides, run_dir, label, cores), run_dir, row,
+                                 args.at)
+                print(f"{law}, {label}: {rows[-1]}", flush=True)
                 continue
-            if run is None:
-                wall, failure = run_one(args.outburst, scene, overrides, run_dir, os.cpu_count() or 1)
-                run = {"law": law, "scene": scene, "overrides": overrides, "wall_s": wall, "failure": failure}
-                with open(kept, "w") as f:
-                    json.dump(run, f)
-            row = {"law": law, "cell": label, "wall_s": run["wall_s"]}
-            if run["failure"]:
-                rows.append(row | {"failure": run["failure"]})
-                print(f"{law}, {label}: {run['failure']}", flush=True)
-                continue
-            particles = len(Run(run_dir).particles(0)["points"])
-            for time in args.at:
-                rows.append(row | {"time_s": time, "particles": particles} | headline(run_dir, time))
-            print(f"{law}, {label}: {rows[-1]}", flush=True)
-    write_rows(os.path.join(args.out, "convergence.csv"), rows)
-    print("\n".join(write(rows, args.laws, args.at, args.out)))
+            # An ensemble at this cell: the same seeds at every cell (though
+            # another cell draws another coal: the draw follows the particles).
+            members = [(seed, os.path.join(args.out, f"{name}_m{args.homogeneity:g}_seed_{seed:03d}"),
+                        overrides + [f"mpm.materials[0].heterogeneity={{homogeneity_index={args.homogeneity:g}, "
+                                     f"seed={seed}}}"]) for seed in range(1, args.seeds + 1)]
+            with concurrent.futures.ThreadPoolExecutor(max_workers=jobs) as pool:
+                runs = list(pool.map(lambda m: kept_or_run(args, law, scene, m[2], m[1], f"{label}, seed {m[0]}",
+                                                           threads), members))
+            for (seed, run_dir, _), run in zip(members, runs):
+                rows += measured(run, run_dir, row | {"seed": seed}, args.at)
+                print(f"{law}, {label}, seed {seed}: {rows[-1]}", flush=True)
+    if not args.seeds:
+        write_rows(os.path.join(args.out, "convergence.csv"), rows)
+        print("\n".join(write(rows, args.laws, args.at, args.out)))
+        return
+    write_rows(os.path.join(args.out, "convergence_ensemble.csv"), rows)
+    lines = ["# Outburst: convergence with resolution over heterogeneous coal", "",
+             f"An ensemble of {args.seeds} seeds at each cell: each quantity's mean +- the 95 % interval of the mean "
+             "(Student t), with the number of seeds that finished.", ""]
+    for time in args.at:
+        for law in args.laws:
+            lines += ensemble_table(rows, law, time, args.homogeneity) + [""]
+    with open(os.path.join(args.out, "convergence_ensemble.md"), "w") as f:
+        f.write("\n".join(lines))
+    print("\n".join(lines))
 
 
 if __name__ == "__main__":

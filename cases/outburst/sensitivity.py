@@ -7,8 +7,8 @@ writes OUT/sensitivity.md and OUT/sensitivity.csv; one run per row (one at a
 time: each uses every core), 11 minutes on 2 cores for the parameter rows;
 --only runs the rows whose label holds one of the TEXTs (--only transfer: the grid
 transfer rows, PIC share 0, 0.01, 0.05 and APIC at the shipped and the double
-resolution, 40 minutes; --only "crack band" heterogeneous: the fracture
-rows). Each finished row is kept in its run folder
+resolution, 40 minutes; --only "crack band" heterogeneous nonlocal: the
+fracture rows). Each finished row is kept in its run folder
 (row.json); --resume reads the rows an interrupted study finished with the
 same overrides and end time instead of running them again.
 """
@@ -60,6 +60,9 @@ VARIANTS += [
     ("heterogeneous m = 1.5, seed 1", ["mpm.materials[0].heterogeneity={homogeneity_index=1.5, seed=1}"]),
     ("crack band 2.4 J/m2, heterogeneous m = 3, seed 1",
      ["CRACK_BAND=2.4 J/m2", "mpm.materials[0].heterogeneity={homogeneity_index=3, seed=1}"]),
+    # Nonlocal damage over the shortest length the shipped cells resolve (two
+    # cells: mpm_solid/README.md), with the shipped eta.
+    ("nonlocal damage, R = 0.75 m", ['mpm.materials[0].internal_length="0.75 m"']),
 ]
 FINE_SEEPAGE_H = 0.25
 
