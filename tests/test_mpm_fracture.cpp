@@ -103,16 +103,36 @@ double cohesive_force(double u) {
   return std::max(sigma, 0.0) * height;
 }
 
-// The bar [0, length] x [0, height] on rollers at x = 0 and y = 0 (a
-// symmetric half), pulled at x = length; h the cell, `local` the paper's law
-// with eta = 5 instead of the crack band.
-Pull pull(double h, ShapeKind shape, bool local) {
-  const Grid<2> gr = grid(length + 3 * h, height, h);
+// The bar's grid and boundaries: [0, length] x [0, height] on rollers at
+// x = 0 and y = 0 (a symmetric half), pulled at x = length by a plate.
+Settings bar_settings(double h, ShapeKind shape) {
   Settings s;
   s.shape = shape;
   s.walls = {Wall{Wall::Type::roller}, Wall{}, Wall{Wall::Type::roller}, Wall{}};
   s.platens.push_back({Vec<2>(length - 0.25 * h, -1), Vec<2>(length + 3 * h, 1), 0, 0, speed});
-  auto particles = block(gr, {0, 0}, {length, height}, coal.density, 2);
+  return s;
+}
+
+// Pulls the bar until the plate has moved `to`; the crack is `ligament` high.
+Pull pull_until(double h, const Settings& s, std::vector<std::unique_ptr<Material>> materials,
+                Particles<2> particles, double to, double ligament) {
+  Solver solver(grid(length + 3 * h, height, h), std::move(materials), std::move(particles), s);
+  Pull r;
+  Curve curve(to);
+  while (solver.platen_displacement()[0] < to) {
+    solver.step(solver.stable_time_step());
+    r.peak_force = std::max(r.peak_force, solver.platen_force()[0]);
+    curve.add(solver.platen_displacement()[0], solver.platen_force()[0]);
+  }
+  r.force = std::move(curve.force);
+  r.dissipated_per_area = solver.energies().damage / ligament;
+  return r;
+}
+
+// The bar pulled apart; h the cell, `local` the paper's law with eta = 5
+// instead of the crack band.
+Pull pull(double h, ShapeKind shape, bool local) {
+  auto particles = block(grid(length + 3 * h, height, h), {0, 0}, {length, height}, coal.density, 2);
   const double band = 0.5 * length;
   for (std::size_t i = 0; i < particles.size(); ++i) {
     const double x = particles.x[i].x();
@@ -129,17 +149,7 @@ Pull pull(double h, ShapeKind shape, bool local) {
     }
     materials.push_back(std::make_unique<ElasticDamage>("coal", coal, d));
   }
-  Solver solver(gr, std::move(materials), std::move(particles), s);
-  Pull r;
-  Curve curve(end);
-  while (solver.platen_displacement()[0] < end) {
-    solver.step(solver.stable_time_step());
-    r.peak_force = std::max(r.peak_force, solver.platen_force()[0]);
-    curve.add(solver.platen_displacement()[0], solver.platen_force()[0]);
-  }
-  r.force = std::move(curve.force);
-  r.dissipated_per_area = solver.energies().damage / height;
-  return r;
+  return pull_until(h, bar_settings(h, shape), std::move(materials), std::move(particles), end, height);
 }
 
 }  // namespace
@@ -293,13 +303,8 @@ namespace {
 constexpr double radius = 0.025, neck_depth = 0.00625, neck_half = 0.0125, eta = 10;
 constexpr double nonlocal_end = 4 * eta * strength / 6e9 * radius;  // [m] of plate travel
 
-Pull pull_nonlocal(double h, ShapeKind shape) {
-  const Grid<2> gr = grid(length + 3 * h, height, h);
-  Settings s;
-  s.shape = shape;
-  s.walls = {Wall{Wall::Type::roller}, Wall{}, Wall{Wall::Type::roller}, Wall{}};
-  s.platens.push_back({Vec<2>(length - 0.25 * h, -1), Vec<2>(length + 3 * h, 1), 0, 0, speed});
-  auto all = block(gr, {0, 0}, {length, height}, coal.density, 2);
+Pull pull_nonlocal(double h) {
+  const auto all = block(grid(length + 3 * h, height, h), {0, 0}, {length, height}, coal.density, 2);
   Particles<2> particles;
   for (std::size_t i = 0; i < all.size(); ++i) {
     const Vec<2> x = all.x[i];
@@ -311,17 +316,8 @@ Pull pull_nonlocal(double h, ShapeKind shape) {
   d.internal_length = radius;
   std::vector<std::unique_ptr<Material>> materials;
   materials.push_back(std::make_unique<ElasticDamage>("coal", coal, d));
-  Solver solver(gr, std::move(materials), std::move(particles), s);
-  Pull r;
-  Curve curve(nonlocal_end);
-  while (solver.platen_displacement()[0] < nonlocal_end) {
-    solver.step(solver.stable_time_step());
-    r.peak_force = std::max(r.peak_force, solver.platen_force()[0]);
-    curve.add(solver.platen_displacement()[0], solver.platen_force()[0]);
-  }
-  r.force = std::move(curve.force);
-  r.dissipated_per_area = solver.energies().damage / (height - neck_depth);
-  return r;
+  return pull_until(h, bar_settings(h, ShapeKind::linear), std::move(materials), std::move(particles), nonlocal_end,
+                    height - neck_depth);
 }
 
 }  // namespace
@@ -333,7 +329,7 @@ TEST_CASE("nonlocal damage: a bar pulled apart dissipates the same energy, along
   std::vector<Pull> pulls;
   std::vector<double> apart;
   for (double h : {radius / 8, radius / 6, radius / 4, radius / 2}) {
-    const Pull& b = pulls.emplace_back(pull_nonlocal(h, ShapeKind::linear));
+    const Pull& b = pulls.emplace_back(pull_nonlocal(h));
     const double off = b.dissipated_per_area / pulls.front().dissipated_per_area - 1;
     apart.push_back(distance(b.force, pulls.front().force, bar_ringing()));
     std::printf("%8.5f %8.1f %20.4f %16.4f %16.4f %12.3f\n", h, radius / h, b.dissipated_per_area, off, apart.back(),
