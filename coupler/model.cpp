@@ -21,6 +21,17 @@ double narrowest_cell(const seepage::Mesh& mesh) {
   return narrowest;
 }
 
+// The smallest and largest draw of the moduli among material m's particles
+// (a heterogeneous material's; {1} for a uniform one): the softest and the
+// stiffest coal bound the regimes the window scheme meets.
+std::vector<double> modulus_scale_range(const mpm::Particles<2>& p, int m) {
+  double lo = std::numeric_limits<double>::infinity(), hi = 0;
+  for (std::size_t i = 0; i < p.modulus_scale.size(); ++i)
+    if (p.material[i] == m) lo = std::min(lo, p.modulus_scale[i]), hi = std::max(hi, p.modulus_scale[i]);
+  if (hi == 0) return {1.0};
+  return {lo, hi};
+}
+
 }  // namespace
 
 std::vector<stability::Regime> poroelastic_regimes(const CoupledSetup& s) {
@@ -32,14 +43,16 @@ std::vector<stability::Regime> poroelastic_regimes(const CoupledSetup& s) {
     hi = hi.cwiseMax(x);
   }
   std::vector<stability::Regime> regimes;
-  for (const auto& material : s.solid.materials)
-    for (const auto& region : s.seepage.model.materials) {
-      const auto& e = material->elasticity();
-      regimes.push_back({e.density, e.lame_lambda() + 2 * e.shear_modulus(),
-                         e.lame_lambda() + 2.0 / 3.0 * e.shear_modulus(), s.solid.settings.viscous_damping,
-                         s.coupling.gas_solid.biot, region.capacity, region.conductivity, (hi - lo).maxCoeff(),
-                         cell});
-    }
+  const auto& p = s.solid.particles;
+  for (std::size_t m = 0; m < s.solid.materials.size(); ++m) {
+    const auto& e = s.solid.materials[m]->elasticity();
+    for (const double stiffness : modulus_scale_range(p, static_cast<int>(m)))
+      for (const auto& region : s.seepage.model.materials)
+        regimes.push_back({e.density, stiffness * (e.lame_lambda() + 2 * e.shear_modulus()),
+                           stiffness * (e.lame_lambda() + 2.0 / 3.0 * e.shear_modulus()),
+                           s.solid.settings.viscous_damping, s.coupling.gas_solid.biot, region.capacity,
+                           region.conductivity, (hi - lo).maxCoeff(), cell});
+  }
   return regimes;
 }
 
@@ -182,10 +195,13 @@ CoupledModel::CoupledModel(CoupledSetup setup, bool settle_later) : setup_(std::
   mapping_ = std::make_unique<MeshMapping>(seepage_->sampler());
   GasSolidSettings gas_solid = cs.gas_solid;
   if (cs.fixed_stress_split.value_or(false)) {
+    // The softest coal's drained bulk modulus: the split's stabilisation must
+    // hold there.
     double bulk = std::numeric_limits<double>::infinity();
-    for (const auto& m : solid_->materials()) {
-      const auto& e = m->elasticity();
-      bulk = std::min(bulk, e.lame_lambda() + 2.0 / 3.0 * e.shear_modulus());
+    for (std::size_t m = 0; m < solid_->materials().size(); ++m) {
+      const auto& e = solid_->materials()[m]->elasticity();
+      const double softest = modulus_scale_range(solid_->particles(), static_cast<int>(m)).front();
+      bulk = std::min(bulk, softest * (e.lame_lambda() + 2.0 / 3.0 * e.shear_modulus()));
     }
     gas_solid.fixed_stress = gas_solid.biot * gas_solid.biot / bulk;
   }

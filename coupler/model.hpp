@@ -34,7 +34,8 @@ CoupledSetup read_coupled_setup(scene::Table root);
 // The same without that resolution: what the scene says, as it says it.
 CoupledSetup read_coupled_scene(scene::Table root);
 
-// The poroelastic regime of every pair of MPM material and seepage region,
+// The poroelastic regime of every pair of MPM material (a heterogeneous one's
+// softest and stiffest draws of the moduli apart) and seepage region,
 // with the modes the seepage mesh carries along its longest extent
 // (coupler/stability.hpp).
 std::vector<stability::Regime> poroelastic_regimes(const CoupledSetup& setup);

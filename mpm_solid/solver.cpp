@@ -597,6 +597,14 @@ void Solver::step_kernel(double dt) {
   }
 }
 
+double Solver::runaway_speed_squared(int i) const {
+  // A stiff draw of a heterogeneous material carries a faster wave; a soft one
+  // is still stepped at the stiffest particle's step, so it is held to its
+  // material's speed.
+  const double stiffness = particles_.modulus_scale.empty() ? 1.0 : std::max(1.0, particles_.modulus_scale[i]);
+  return stiffness * wave_speed_squared_[particles_.material[i]];
+}
+
 // Books a moved particle: the work of a pore pressure on it, and whether it
 // went wrong or left.
 void Solver::count(int i, double dt, Census& census) const {
@@ -608,8 +616,7 @@ void Solver::count(int i, double dt, Census& census) const {
     ++census.bad;
   else if (!grid_.inside(p.x[i]))
     ++census.escaped;
-  else if (p.v[i].squaredNorm() >
-           (p.modulus_scale.empty() ? 1.0 : p.modulus_scale[i]) * wave_speed_squared_[p.material[i]])
+  else if (p.v[i].squaredNorm() > runaway_speed_squared(i))
     ++census.runaway;
 }
 
@@ -633,14 +640,13 @@ void Solver::remove_escaped(const Census& census, StepInfo& info) {
   // the energy is exploding. Stop before it turns into NaN.
   if (runaway > 0 && bad == 0)
     for (int i = 0; i < n; ++i) {
-      const double stiffness = p.modulus_scale.empty() ? 1.0 : p.modulus_scale[i];
-      if (p.v[i].squaredNorm() <= stiffness * wave_speed_squared_[p.material[i]]) continue;
+      if (p.v[i].squaredNorm() <= runaway_speed_squared(i)) continue;
       throw SimulationError(fmt::format(
           "mpm: step {} (t = {:.6g} s): the energy is exploding: particle {} (material \"{}\") has a velocity "
           "of {:.3g} m/s, above its P-wave speed {:.3g} m/s; the time step may exceed the stable one, or a load "
           "is out of range",
           steps_ + 1, time_, p.id[i], materials_[p.material[i]]->name(), p.v[i].norm(),
-          std::sqrt(stiffness * wave_speed_squared_[p.material[i]])));
+          std::sqrt(runaway_speed_squared(i))));
     }
   if (bad > 0)
     for (int i = 0; i < n; ++i) {

@@ -313,7 +313,9 @@ class Solver {
   void (Solver::*kernel_)(double) = nullptr;
 
   std::vector<std::vector<int>> members_;  // particle indices per material
-  std::vector<double> wave_speed_squared_;  // per material (times a particle's modulus_scale), for the runaway check
+  std::vector<double> wave_speed_squared_;  // per material, for the runaway check
+  // Square of the speed beyond which particle i is running away.
+  double runaway_speed_squared(int i) const;
   double empty_node_mass_ = 0;
 
   // Grid fields; per-thread copies of the scattered ones avoid locks.

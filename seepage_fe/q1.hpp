@@ -90,16 +90,16 @@ inline Integrals integrals(const Corners& x) {
 // (with a small tolerance so points on shared edges are found).
 inline std::optional<Eigen::Vector2d> inverse_map(const Corners& x, const Eigen::Vector2d& point) {
   // Newton has converged once its step is at the roundoff of the coordinates:
-  // about eps |x| in space, eps |x| / (cell size) in reference coordinates.
-  // For a small cell far from the origin that lies above any fixed bound (a
-  // cell of 1/8 m at x = 40 m: 1.4e-13), and a bound below it missed every
-  // point of the cell.
-  double reach = 0, size = 0;
+  // about eps |x| in space, eps |x| / (the cell's thinnest side) in reference
+  // coordinates. For a small or thin cell far from the origin that lies above
+  // any fixed bound (a cell of 1/8 m at x = 40 m: 1.4e-13), and a bound below
+  // it missed every point of the cell.
+  double reach = 0, thinnest = std::numeric_limits<double>::infinity();
   for (int a = 0; a < 4; ++a) {
     reach = std::max(reach, x[a].lpNorm<Eigen::Infinity>());
-    size = std::max(size, (x[a] - x[0]).lpNorm<Eigen::Infinity>());
+    thinnest = std::min(thinnest, (x[(a + 1) % 4] - x[a]).norm());
   }
-  const double tolerance = std::max(1e-13, 64 * std::numeric_limits<double>::epsilon() * reach / size);
+  const double tolerance = std::max(1e-13, 64 * std::numeric_limits<double>::epsilon() * reach / thinnest);
   Eigen::Vector2d ref = Eigen::Vector2d::Zero();
   bool converged = false;
   for (int it = 0; it < 30; ++it) {

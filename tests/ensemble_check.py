@@ -50,7 +50,7 @@ def main():
     other = coal(os.path.join(side_by_side, "seed_002"))
     print(f"seed 1: {len(one_thread) // 2} particles, factors {one_thread.min():.3f}-{one_thread.max():.3f}, "
           f"mean {one_thread.mean():.4f}; on two threads identical: {np.array_equal(one_thread, two_threads)}; "
-          f"seed 2 differs in {np.count_nonzero(one_thread != other)} particles")
+          f"seed 2 differs in {np.count_nonzero(one_thread != other)} of the {len(other)} factors")
     if (os.cpu_count() or 1) > 1 and not np.array_equal(one_thread, two_threads):
         failures.append("seed 1 drew another coal on two threads than on one")
     if np.count_nonzero(one_thread != other) < 0.99 * len(other):

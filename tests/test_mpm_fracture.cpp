@@ -61,7 +61,7 @@ struct Curve {
 struct Pull {
   double dissipated_per_area = 0;  // by damage, over the crack area [J/m2]
   double peak_force = 0;           // [N/m]
-  std::vector<double> force;       // [N/m] at u = end k / samples
+  std::vector<double> force;       // [N/m] at u = (the plate's travel) k / samples
 };
 
 // The running mean of f over 2 half + 1 samples (where it has them all).
@@ -83,10 +83,11 @@ double distance(const std::vector<double>& a, const std::vector<double>& b, int 
   return gap / size;
 }
 
-// The bar rings at period 2 L / c: half of it in samples of the plate's travel.
-int bar_ringing() {
+// The bar rings at period 2 L / c: half of it in samples of a plate's travel
+// to `to`.
+int bar_ringing(double to = end) {
   const double period = 2 * length / std::sqrt(coal.youngs_modulus / coal.density) * speed;
-  return static_cast<int>(0.5 * period / (end / samples));
+  return static_cast<int>(0.5 * period / (to / samples));
 }
 
 // Plate force of a cohesive crack with linear softening in the bar [N/m] at
@@ -331,7 +332,7 @@ TEST_CASE("nonlocal damage: a bar pulled apart dissipates the same energy, along
   for (double h : {radius / 8, radius / 6, radius / 4, radius / 2}) {
     const Pull& b = pulls.emplace_back(pull_nonlocal(h));
     const double off = b.dissipated_per_area / pulls.front().dissipated_per_area - 1;
-    apart.push_back(distance(b.force, pulls.front().force, bar_ringing()));
+    apart.push_back(distance(b.force, pulls.front().force, bar_ringing(nonlocal_end)));
     std::printf("%8.5f %8.1f %20.4f %16.4f %16.4f %12.3f\n", h, radius / h, b.dissipated_per_area, off, apart.back(),
                 b.peak_force / 1e3);
     // With R over at least four cells, the energy and the curve are the
@@ -341,7 +342,7 @@ TEST_CASE("nonlocal damage: a bar pulled apart dissipates the same energy, along
       CHECK(apart.back() < 0.03);
     }
     // The bar cracked: the load fell to below 70 % of its peak.
-    CHECK(running_mean(b.force, samples - 1 - bar_ringing(), bar_ringing()) < 0.7 * b.peak_force);
+    CHECK(running_mean(b.force, samples - 1 - bar_ringing(nonlocal_end), bar_ringing(nonlocal_end)) < 0.7 * b.peak_force);
   }
   // The curves approach the finest one as the cells shrink.
   CHECK(apart[1] < apart[2]);

@@ -167,9 +167,10 @@ TEST_CASE("points are located in small cells far from the origin", "[seepage][me
   // no pore pressure, and the cells read as open space.
   const double cell = GENERATE(0.125, 1.0 / 6, 0.01);
   const double far = GENERATE(45.0, 1e3, -2e3);
+  const double aspect = GENERATE(1.0, 100.0);  // thin cells: the roundoff goes as the thinnest side
   StructuredMeshSpec spec;
   spec.origin = {far, -far};
-  spec.size = {40 * cell, 20 * cell};
+  spec.size = {40 * cell * aspect, 20 * cell};
   spec.cells = {40, 20};
   spec.regions = {{"all", true, {}, {}}};
   const Mesh m = make_structured_mesh(spec);
@@ -177,7 +178,7 @@ TEST_CASE("points are located in small cells far from the origin", "[seepage][me
   int found = 0, points = 0;
   for (int i = 0; i < 160; ++i)
     for (int j = 0; j < 80; ++j, ++points) {
-      const Eigen::Vector2d x = spec.origin + cell * Eigen::Vector2d((i + 0.5) / 4, (j + 0.5) / 4);
+      const Eigen::Vector2d x = spec.origin + cell * Eigen::Vector2d(aspect * (i + 0.5) / 4, (j + 0.5) / 4);
       const auto hit = locator.locate(x);
       if (!hit) continue;
       ++found;
@@ -187,6 +188,6 @@ TEST_CASE("points are located in small cells far from the origin", "[seepage][me
       for (int a = 0; a < 4; ++a) back += n[a] * m.nodes[c[a]];
       CHECK((back - x).norm() < 1e-9 * cell + 1e-13 * std::abs(far));
     }
-  INFO("cells of " << cell << " m at " << far << " m");
+  INFO("cells of " << cell << " m by " << aspect * cell << " m at " << far << " m");
   CHECK(found == points);
 }

@@ -98,8 +98,8 @@ double weibull_strength_scale(const DamageParameters::Heterogeneity& h, std::int
 }
 
 double weibull_modulus_scale(const DamageParameters::Heterogeneity& h, std::int64_t id) {
-  // The next value of the strength's stream: independent of it, and of the
-  // seed and the id alone.
+  // A second hash of the strength's bits: independent of the strength's
+  // draw, and a function of the seed and the id alone.
   return weibull(h.modulus_index(), mix(strength_bits(h, id)));
 }
 
@@ -334,6 +334,10 @@ std::unique_ptr<Material> read(const scene::Table& m, const MaterialContext& c) 
                                                        "about R wide, softening linearly to nothing at eta",
                                     "", Range::positive()},
                                    units::length);
+    if (d.ultimate_ratio <= 1)
+      m.fail("ultimate_strain_ratio", fmt::format("must be > 1 with an internal_length (nonlocal damage softens from "
+                                                  "1 to eta), got {:g}",
+                                                  d.ultimate_ratio));
     // Fewer than two cells across R: too few particles to average over, and
     // the zone would follow the cell again.
     if (*d.internal_length < 2 * c.cell_size)

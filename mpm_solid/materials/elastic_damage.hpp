@@ -48,11 +48,13 @@ struct DamageParameters {
   // linearly in that average from f_t at 1 to nothing at eta:
   // D = 1 - (eta - e) / ((eta - 1) e). The crack then spreads over a zone
   // about as wide as R whatever the cell, so the energy it takes converges as
-  // the cells shrink. A point weighs in its neighbours' averages by its
-  // volume times (1 - D), and its own value is capped at eta: a crack ends the
-  // interaction across it (Geers et al. 1998 let it fade likewise), where the
-  // opening of broken points would otherwise drive their neighbours' damage
-  // on and the zone would spread without end. Shear damage stays local.
+  // the cells shrink. A point's own value is capped at eta, and a fully
+  // damaged point drops out of its neighbours' averages: a crack ends the
+  // interaction across it, where the opening of broken points would otherwise
+  // drive their neighbours' damage on and the zone would spread without end.
+  // (Weighting by 1 - D instead delocalises: a softening point then pulls its
+  // neighbours' averages down, and the damage spreads over the whole bar.)
+  // Shear damage stays local.
   std::optional<double> internal_length = std::nullopt;
   // Largest volume of fully damaged material over its initial volume. Broken
   // coal bulks to a loose heap; beyond that its fragments part and the gaps are
@@ -98,8 +100,6 @@ class ElasticDamage final : public Material {
   // factors on the strengths and the moduli.
   double damage(double previous, const Mat<2>& effective, double effective_zz, double scale = 1.0,
                 double stiffness = 1.0) const;
-  // Tensile damage of nonlocal damage from the averaged driving strain.
-  double nonlocal_tensile_damage(double averaged) const;
   const DamageParameters& parameters() const { return parameters_; }
   double strain_energy(const Particles<2>& p, const std::vector<int>& members) const override;
 
@@ -115,6 +115,8 @@ class ElasticDamage final : public Material {
   // The local driver of nonlocal damage: eps_1 over the strain at f_t, in
   // [0, eta].
   double driving_strain(const Mat<2>& effective, double effective_zz, double scale, double stiffness) const;
+  // Tensile damage of nonlocal damage from the averaged driving strain.
+  double nonlocal_tensile_damage(double averaged) const;
 };
 
 }  // namespace outburst::mpm
