@@ -465,6 +465,25 @@ def outburst_fracture_sensitivity(rows):
     return table([{k: (v if k in text or not v else float(v)) for k, v in r.items()} for r in rows])
 
 
+@block("outburst front speeds", "cases/outburst/convergence/front_speeds.csv")
+def outburst_front_speeds(rows):
+    from .outburst.front import FRONTS
+    fronts = [(key[:-2], label) for key, label in FRONTS]
+    lines = ["| law | cell | " + " | ".join(f"{label} [m/s]" for _, label in fronts) + " |",
+             "|---|---|" + "---|" * len(fronts)]
+    for r in rows:
+        cells = []
+        for key, _ in fronts:
+            speed, points = float(r[f"{key}_m_per_s"]), int(float(r[f"{key}_points"]))
+            cells.append("-" if not math.isfinite(speed) else f"{speed:.3g} ({points} points)")
+        lines.append(f"| {r['law'].replace('_', ' ')} | {r['cell']} | " + " | ".join(cells) + " |")
+    laws = list(dict.fromkeys(r["law"] for r in rows))
+    lines.append("| exponent a of speed ~ h^-a | | " + " | ".join(
+        ", ".join(f"{law.replace('_', ' ')} {float(next(r for r in rows if r['law'] == law)[f'{key}_exponent']):.2f}"
+                  for law in laws) for key, _ in fronts) + " |")
+    return lines
+
+
 def blocks_of(path, lines):
     """(name, first line index inside, index of the end marker) of each block in a README's lines."""
     found, open_at = [], None

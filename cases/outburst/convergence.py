@@ -226,7 +226,7 @@ def main():
                 runs = list(pool.map(lambda m: kept_or_run(args, law, scene, m[2], m[1], f"{label}, seed {m[0]}",
                                                            threads), members))
             for (seed, run_dir, _), run in zip(members, runs):
-                rows += measured(run, run_dir, row | {"seed": seed}, args.at)
+                rows += measured(run, run_dir, row | {"seed": seed, "homogeneity": args.homogeneity}, args.at)
                 print(f"{law}, {label}, seed {seed}: {rows[-1]}", flush=True)
     if not args.seeds:
         write_rows(os.path.join(args.out, "convergence.csv"), rows)
