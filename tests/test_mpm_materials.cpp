@@ -345,6 +345,41 @@ TEST_CASE("heterogeneous coal: a particle's modulus factor sets its wave speed, 
         Approx(0.5 * -one.stress[0](0, 0) * 1e-5 * one.volume[0]).epsilon(1e-6));
 }
 
+TEST_CASE("heterogeneous coal: a particle s_E times as stiff, strained 1 / s_E as much, carries the same stress, "
+          "damage and friction, with 1 / s_E the plastic strain and work", "[mpm][material][damage][heterogeneity]") {
+  DamageParameters d = coal_damage;
+  d.heterogeneity = DamageParameters::Heterogeneity{3.0, 1};
+  const ElasticDamage m("coal", coal, d);
+  // Pure shear under a little compression (no spin: the Jaumann rotation goes
+  // with the strain, not the moduli): into the friction cone and past the
+  // shear damage's onset.
+  Mat<2> l;
+  l << -2e-5, 1e-4, 1e-4, -2e-5;
+  const double stiffness = 2.5;
+  Particles<2> uniform = one_particle(), stiff = one_particle();
+  for (Particles<2>* p : {&uniform, &stiff}) {
+    p->need("heterogeneity");
+    p->strength_scale[0] = 1;
+  }
+  uniform.modulus_scale[0] = 1;
+  stiff.modulus_scale[0] = stiffness;
+  Dissipation by_uniform, by_stiff;
+  for (int s = 0; s < 400; ++s) {
+    uniform.velocity_gradient[0] = l;
+    stiff.velocity_gradient[0] = l / stiffness;
+    by_uniform += m.update_stress(uniform, {0}, 0.1);
+    by_stiff += m.update_stress(stiff, {0}, 0.1);
+  }
+  REQUIRE(uniform.plastic_strain[0] > 0);
+  REQUIRE(uniform.damage[0] > 0);
+  CHECK((stiff.stress[0] - uniform.stress[0]).norm() < 1e-6 * uniform.stress[0].norm());
+  CHECK(stiff.damage[0] == Approx(uniform.damage[0]).epsilon(1e-6));
+  CHECK(stiff.plastic_strain[0] == Approx(uniform.plastic_strain[0] / stiffness).epsilon(1e-6));
+  // The volumes differ by the strains' difference: compare work per volume.
+  CHECK(by_stiff.plastic / stiff.volume[0] ==
+        Approx(by_uniform.plastic / uniform.volume[0] / stiffness).epsilon(1e-3));
+}
+
 TEST_CASE("crack band: a material point dissipates G_f per band width whatever holds its sides, and s_f^2 / s_E times as "
           "much with factors s_f, s_E on its strength and moduli", "[mpm][material]") {
   // nu = 0.4 (Table 1), a band at 90 % of the snap-back limit: the onset's
