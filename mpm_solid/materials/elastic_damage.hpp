@@ -46,9 +46,9 @@ struct DamageParameters {
   // particle's strain at f_t, eps_1 E0 / f_t, averaged over the particles
   // within the internal length R [m] (mpm_solid/nonlocal.hpp), and softens
   // linearly in that average from f_t at 1 to nothing at eta:
-  // D = 1 - (eta - e) / ((eta - 1) e). The crack then spreads over a zone
-  // about as wide as R whatever the cell, so the energy it takes converges as
-  // the cells shrink. A point's own value is capped at eta, and a fully
+  // D = 1 - (eta - e) / ((eta - 1) e). The crack then spreads over a zone a
+  // few R wide whatever the cell, so the energy it takes converges as the
+  // cells shrink. A point's own value is capped at eta, and a fully
   // damaged point drops out of its neighbours' averages: a crack ends the
   // interaction across it, where the opening of broken points would otherwise
   // drive their neighbours' damage on and the zone would spread without end.
