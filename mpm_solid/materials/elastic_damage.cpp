@@ -297,6 +297,11 @@ std::unique_ptr<Material> read(const scene::Table& m, const MaterialContext& c) 
                                                  "under the local law (the paper gives none; 0.1 is common "
                                                  "for RFPA models)",
                                "0.1", Range{0.0, 1.0, true, false}});
+  // The two regularised laws exclude each other: said before either checks
+  // its resolution.
+  if (m.has("fracture_energy") && m.has("internal_length"))
+    m.fail("internal_length", "give a fracture_energy (a crack band) or an internal_length (nonlocal damage), "
+                              "not both");
   if (m.has("fracture_energy")) {
     // Crack band: the ultimate strain follows from G_f and the width of the
     // narrowest band the grid's velocity field can open.
@@ -326,9 +331,6 @@ std::unique_ptr<Material> read(const scene::Table& m, const MaterialContext& c) 
                                  "5", Range::at_least(1)});
   }
   if (m.has("internal_length")) {
-    if (d.fracture_energy)
-      m.fail("internal_length", "give a fracture_energy (a crack band) or an internal_length (nonlocal damage), "
-                                "not both");
     d.internal_length = m.quantity({"internal_length", "R, radius over which nonlocal damage averages its driving "
                                                        "strain (a bell-shaped weight): the crack spreads over a zone "
                                                        "about R wide, softening linearly to nothing at eta",
