@@ -48,13 +48,13 @@ struct DamageParameters {
   // linearly in that average from f_t at 1 to nothing at eta:
   // D = 1 - (eta - e) / ((eta - 1) e). The crack then spreads over a zone a
   // few R wide whatever the cell, so the energy it takes converges as the
-  // cells shrink. A point's own value is capped at eta, and a fully
-  // damaged point drops out of its neighbours' averages: a crack ends the
-  // interaction across it, where the opening of broken points would otherwise
-  // drive their neighbours' damage on and the zone would spread without end.
-  // (Weighting by 1 - D instead delocalises: a softening point then pulls its
-  // neighbours' averages down, and the damage spreads over the whole bar.)
-  // Shear damage stays local.
+  // cells shrink (the zone widens as it softens). A point's own value is
+  // capped at eta, and a fully damaged point drops out of its neighbours'
+  // averages: a crack ends the interaction across it, where the opening of
+  // broken points would drive their neighbours' damage on. (Weighting by
+  // 1 - D instead delocalises: a softening point then pulls its neighbours'
+  // averages down, and the damage spreads over the whole bar.) Shear damage
+  // stays local.
   std::optional<double> internal_length = std::nullopt;
   // Largest volume of fully damaged material over its initial volume. Broken
   // coal bulks to a loose heap; beyond that its fragments part and the gaps are
