@@ -25,7 +25,6 @@ where it is inside the seam (short of the last bin before the seam's end);
 speed ~ h^-a is fitted over the cells with a speed, per law and front.
 """
 import argparse
-import csv
 import glob
 import json
 import os
@@ -37,6 +36,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
+from ..runs import write_rows
 from ..units import value
 from .report import Run, axis_row, tunnel
 
@@ -153,14 +153,6 @@ def speeds(rows):
     return out
 
 
-def write_csv(rows, path):
-    with open(path, "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(rows[0]))
-        w.writeheader()
-        for r in rows:
-            w.writerow({k: f"{v:.6g}" if isinstance(v, float) else v for k, v in r.items()})
-
-
 def figure(rows, fitted, path):
     laws = sorted({r["law"] for r in rows})
     fig, axes = plt.subplots(len(laws), len(FRONTS) + 1, figsize=(18, 4.2 * len(laws)), squeeze=False,
@@ -222,8 +214,8 @@ def main():
         sys.exit(f"no run with output in {args.runs}")
     fitted = speeds(rows)
     os.makedirs(args.out, exist_ok=True)
-    write_csv(rows, os.path.join(args.out, "front.csv"))
-    write_csv(fitted, os.path.join(args.out, "front_speeds.csv"))
+    write_rows(os.path.join(args.out, "front.csv"), rows)
+    write_rows(os.path.join(args.out, "front_speeds.csv"), fitted)
     figure(rows, fitted, os.path.join(args.out, "front.png"))
     print("law         cell    cell ratio" + "".join(f"{k.removesuffix('_m'):>26}" for k, _ in FRONTS)
           + "   [m/s, ratio to coarser]")
