@@ -416,9 +416,7 @@ Setup read_setup(const scene::Table& s) {
   read_bodies(s, setup, names);
   // The materials' own particle fields (a heterogeneous coal's draws) now, so
   // that the checks on the step see the particles as the solver will.
-  std::vector<std::vector<int>> members(setup.materials.size());
-  for (std::size_t i = 0; i < setup.particles.size(); ++i)
-    members[static_cast<std::size_t>(setup.particles.material[i])].push_back(static_cast<int>(i));
+  const auto members = material_members(setup.particles, setup.materials.size());
   for (std::size_t m = 0; m < members.size(); ++m) setup.materials[m]->create_fields(setup.particles, members[m]);
   read_tractions(s, setup);
   read_tracers(s, setup);

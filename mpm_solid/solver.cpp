@@ -182,10 +182,14 @@ void Solver::find_obstacle_nodes() {
   }
 }
 
-void Solver::rebuild_material_groups() {
-  members_.assign(materials_.size(), {});
-  for (std::size_t p = 0; p < particles_.size(); ++p) members_[particles_.material[p]].push_back(static_cast<int>(p));
+std::vector<std::vector<int>> material_members(const Particles<2>& particles, std::size_t materials) {
+  std::vector<std::vector<int>> members(materials);
+  for (std::size_t p = 0; p < particles.size(); ++p)
+    members[static_cast<std::size_t>(particles.material[p])].push_back(static_cast<int>(p));
+  return members;
 }
+
+void Solver::rebuild_material_groups() { members_ = material_members(particles_, materials_.size()); }
 
 double stable_time_step(const std::vector<std::unique_ptr<Material>>& materials, const Particles<2>& particles,
                         double h, double courant) {

@@ -194,6 +194,9 @@ struct Census {
   }
 };
 
+// The indices of each material's particles, in order.
+std::vector<std::vector<int>> material_members(const Particles<2>& particles, std::size_t materials);
+
 // Largest stable step: courant h / max over particles of (c_p + |v_p|), c_p
 // the P-wave speed of each particle's material at its current density and
 // with its draw of the moduli (a heterogeneous material's modulus_scale).

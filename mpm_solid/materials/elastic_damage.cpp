@@ -333,7 +333,7 @@ std::unique_ptr<Material> read(const scene::Table& m, const MaterialContext& c) 
   if (m.has("internal_length")) {
     d.internal_length = m.quantity({"internal_length", "R, radius over which nonlocal damage averages its driving "
                                                        "strain (a bell-shaped weight): the crack spreads over a zone "
-                                                       "about R wide, softening linearly to nothing at eta",
+                                                       "a few R wide, softening linearly to nothing at eta",
                                     "", Range::positive()},
                                    units::length);
     if (d.ultimate_ratio <= 1)
