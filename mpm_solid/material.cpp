@@ -11,6 +11,10 @@ double Elasticity::p_wave_speed() const {
   return std::sqrt((lame_lambda() + 2 * shear_modulus()) / density);
 }
 
+Dissipation Material::update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const {
+  return over_chunks(members, [&](std::span<const int> part) { return update_chunk(p, part, dt); });
+}
+
 double Material::strain_energy(const Particles<2>& p, const std::vector<int>& members) const {
   return sum_over(members, [&](int i) {
     return 0.5 * p.volume[i] * compliance_product(p.stress[i], p.stress_zz[i], p.stress[i], p.stress_zz[i]);

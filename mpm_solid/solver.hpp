@@ -291,6 +291,8 @@ class Solver {
   template <class Shape>
   void scatter_forces();
   template <class Shape>
+  void update_and_scatter(double dt);
+  template <class Shape>
   void gather_velocity_gradient();
   template <class Shape>
   void smooth_dilatation();
@@ -314,6 +316,10 @@ class Solver {
   Particles<2> particles_;
   Settings settings_;
   void (Solver::*kernel_)(double) = nullptr;
+  // Every particle's stress update reads only its own fields, and no
+  // smoothing of the dilatation runs between the gather and the update: USF
+  // fuses them with the force scatter (update_and_scatter).
+  bool pointwise_ = false;
 
   std::vector<std::vector<int>> members_;  // particle indices per material
   std::vector<double> wave_speed_squared_;  // per material, for the runaway check

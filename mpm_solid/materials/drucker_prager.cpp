@@ -23,7 +23,7 @@ double DruckerPrager::return_map(Mat<2>& s, double& s_zz, double* work_density) 
                                work_density);
 }
 
-Dissipation DruckerPrager::update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const {
+Dissipation DruckerPrager::update_chunk(Particles<2>& p, std::span<const int> members, double dt) const {
   // Equivalent plastic strain per unit multiplier: sqrt(2/3 |dg/dsigma|^2).
   const double strain_per_multiplier = std::sqrt(2.0 / 3.0 * (0.5 + alpha_dilation_ * alpha_dilation_ / 3));
   return each_member(p, members, dt, [&](int i) {

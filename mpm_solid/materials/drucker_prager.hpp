@@ -15,7 +15,7 @@ class DruckerPrager final : public Material {
   void create_fields(Particles<2>& p, const std::vector<int>&) const override {
     p.need_plastic_strain();
   }
-  Dissipation update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const override;
+  Dissipation update_chunk(Particles<2>& p, std::span<const int> members, double dt) const override;
 
   double alpha() const { return alpha_; }
   double k() const { return k_; }

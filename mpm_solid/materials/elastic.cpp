@@ -2,7 +2,7 @@
 
 namespace outburst::mpm {
 
-Dissipation LinearElastic::update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const {
+Dissipation LinearElastic::update_chunk(Particles<2>& p, std::span<const int> members, double dt) const {
   return each_member(p, members, dt, [&](int i) {
     elastic_trial(elasticity(), p.velocity_gradient[i], dt, p.stress[i], p.stress_zz[i]);
     return Dissipation{};

@@ -7,7 +7,7 @@ namespace outburst::mpm {
 class LinearElastic final : public Material {
  public:
   using Material::Material;
-  Dissipation update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const override;
+  Dissipation update_chunk(Particles<2>& p, std::span<const int> members, double dt) const override;
 };
 
 }  // namespace outburst::mpm

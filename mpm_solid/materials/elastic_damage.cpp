@@ -181,71 +181,88 @@ double ElasticDamage::nonlocal_tensile_damage(double averaged) const {
   return 1 - (eta - averaged) / ((eta - 1) * averaged);
 }
 
+double ElasticDamage::strength_scale(const Particles<2>& p, int i) const {
+  return parameters_.heterogeneity ? p.strength_scale[i] : 1.0;
+}
+
+double ElasticDamage::modulus_scale(const Particles<2>& p, int i) const {
+  return parameters_.heterogeneity ? p.modulus_scale[i] : 1.0;
+}
+
+void ElasticDamage::trial(Particles<2>& p, int i, double dt) const {
+  Elasticity own = elasticity();
+  own.youngs_modulus *= modulus_scale(p, i);  // lambda and G scale with E
+  elastic_trial(own, p.velocity_gradient[i], dt, p.effective_stress[i], p.effective_stress_zz[i]);
+}
+
+// The acting stress at damage d, what the growth of damage took, and the
+// friction of compressive states.
+Dissipation ElasticDamage::settle(Particles<2>& p, int i, double d) const {
+  const double stiffness = modulus_scale(p, i);
+  const double g = stiffness * elasticity().shear_modulus();
+  const double bulk = stiffness * elasticity().lame_lambda() + 2.0 / 3.0 * g;
+  Dissipation dissipated;
+  Mat<2>& effective = p.effective_stress[i];
+  double& effective_zz = p.effective_stress_zz[i];
+  const double previous = p.damage[i];
+  p.damage[i] = d;
+  // The stress acting: open cracks carry no share of tension.
+  const Principal pr = principal(effective);
+  Mat<2> s = compose(crack(pr.a, 1 - d), crack(pr.b, 1 - d), pr.direction);
+  double s_zz = crack(effective_zz, 1 - d);
+  if (d > previous) {
+    // Y dD: the energy the cracks take at the strain they opened at.
+    const Mat<2> before = compose(crack(pr.a, 1 - previous), crack(pr.b, 1 - previous), pr.direction);
+    const double before_zz = crack(effective_zz, 1 - previous);
+    dissipated.damage = 0.5 * p.volume[i] *
+                        (compliance_product(before, before_zz, effective, effective_zz) -
+                         compliance_product(s, s_zz, effective, effective_zz)) /
+                        stiffness;
+  }
+  // Friction bounds compressive states, with the cohesion the cracks leave;
+  // tension is the damage law's to soften (a cone there would cap the elastic
+  // strain the damage is read from).
+  double work = 0;
+  const bool compressive = s.trace() + s_zz < 0;
+  if (const double multiplier =
+          compressive ? drucker_prager_return(alpha_, (1 - d) * strength_scale(p, i) * k0_, 0.0, g, bulk, s, s_zz, &work)
+                      : 0.0;
+      multiplier > 0) {
+    p.plastic_strain[i] += multiplier / std::sqrt(3.0);  // no dilation: sqrt(2/3 |dg/dsigma|^2) = 1/sqrt(3)
+    dissipated.plastic = p.volume[i] * work;
+    // Carry the return back to the undamaged stress (same principal axes).
+    const Principal back = principal(s);
+    const double open = d < 1 ? 1 / (1 - d) : 0.0;
+    effective = compose(crack(back.a, open), crack(back.b, open), back.direction);
+    effective_zz = crack(s_zz, open);
+  }
+  p.stress[i] = s;
+  p.stress_zz[i] = s_zz;
+  if (d >= 1) p.volume[i] = std::min(p.volume[i], parameters_.bulking_factor * p.volume0[i]);
+  return dissipated;
+}
+
+Dissipation ElasticDamage::update_chunk(Particles<2>& p, std::span<const int> members, double dt) const {
+  if (!pointwise()) throw std::logic_error("nonlocal damage updates a material's particles together (update_stress)");
+  return each_member(p, members, dt, [&](int i) {
+    trial(p, i, dt);
+    return settle(p, i,
+                  damage(p.damage[i], p.effective_stress[i], p.effective_stress_zz[i], strength_scale(p, i),
+                         modulus_scale(p, i)));
+  });
+}
+
 Dissipation ElasticDamage::update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const {
-  const double g0 = elasticity().shear_modulus(), bulk0 = elasticity().lame_lambda() + 2.0 / 3.0 * g0;
-  const bool heterogeneous = parameters_.heterogeneity.has_value();
-  const auto scale = [&](int i) { return heterogeneous ? p.strength_scale[i] : 1.0; };
-  const auto stiffness = [&](int i) { return heterogeneous ? p.modulus_scale[i] : 1.0; };
-  const auto trial = [&](int i) {
-    Elasticity own = elasticity();
-    own.youngs_modulus *= stiffness(i);  // lambda and G scale with E
-    elastic_trial(own, p.velocity_gradient[i], dt, p.effective_stress[i], p.effective_stress_zz[i]);
-  };
-  // The acting stress at damage d, what the growth of damage took, and the
-  // friction of compressive states.
-  const auto settle = [&](int i, double d) {
-    Dissipation dissipated;
-    Mat<2>& effective = p.effective_stress[i];
-    double& effective_zz = p.effective_stress_zz[i];
-    const double previous = p.damage[i];
-    p.damage[i] = d;
-    // The stress acting: open cracks carry no share of tension.
-    const Principal pr = principal(effective);
-    Mat<2> s = compose(crack(pr.a, 1 - d), crack(pr.b, 1 - d), pr.direction);
-    double s_zz = crack(effective_zz, 1 - d);
-    if (d > previous) {
-      // Y dD: the energy the cracks take at the strain they opened at.
-      const Mat<2> before = compose(crack(pr.a, 1 - previous), crack(pr.b, 1 - previous), pr.direction);
-      const double before_zz = crack(effective_zz, 1 - previous);
-      dissipated.damage = 0.5 * p.volume[i] *
-                          (compliance_product(before, before_zz, effective, effective_zz) -
-                           compliance_product(s, s_zz, effective, effective_zz)) /
-                          stiffness(i);
-    }
-    // Friction bounds compressive states, with the cohesion the cracks leave;
-    // tension is the damage law's to soften (a cone there would cap the elastic
-    // strain the damage is read from).
-    double work = 0;
-    const bool compressive = s.trace() + s_zz < 0;
-    if (const double multiplier = compressive ? drucker_prager_return(alpha_, (1 - d) * scale(i) * k0_, 0.0,
-                                                                      stiffness(i) * g0, stiffness(i) * bulk0, s,
-                                                                      s_zz, &work)
-                                              : 0.0;
-        multiplier > 0) {
-      p.plastic_strain[i] += multiplier / std::sqrt(3.0);  // no dilation: sqrt(2/3 |dg/dsigma|^2) = 1/sqrt(3)
-      dissipated.plastic = p.volume[i] * work;
-      // Carry the return back to the undamaged stress (same principal axes).
-      const Principal back = principal(s);
-      const double open = d < 1 ? 1 / (1 - d) : 0.0;
-      effective = compose(crack(back.a, open), crack(back.b, open), back.direction);
-      effective_zz = crack(s_zz, open);
-    }
-    p.stress[i] = s;
-    p.stress_zz[i] = s_zz;
-    if (d >= 1) p.volume[i] = std::min(p.volume[i], parameters_.bulking_factor * p.volume0[i]);
-    return dissipated;
-  };
-  if (!parameters_.internal_length)
-    return each_member(p, members, dt, [&](int i) {
-      trial(i);
-      return settle(i, damage(p.damage[i], p.effective_stress[i], p.effective_stress_zz[i], scale(i), stiffness(i)));
-    });
+  if (pointwise()) return Material::update_stress(p, members, dt);
   // Nonlocal: every member's trial stress and driving strain first, then
   // their averages over the internal length, then the damage.
-  each_member(p, members, dt, [&](int i) {
-    trial(i);
-    p.nonlocal_strain[i] = driving_strain(p.effective_stress[i], p.effective_stress_zz[i], scale(i), stiffness(i));
-    return Dissipation{};
+  over_chunks(members, [&](std::span<const int> part) {
+    return each_member(p, part, dt, [&](int i) {
+      trial(p, i, dt);
+      p.nonlocal_strain[i] = driving_strain(p.effective_stress[i], p.effective_stress_zz[i], strength_scale(p, i),
+                                            modulus_scale(p, i));
+      return Dissipation{};
+    });
   });
   std::vector<double> local(members.size()), weight(members.size());
   for (std::size_t k = 0; k < members.size(); ++k) {
@@ -260,11 +277,12 @@ Dissipation ElasticDamage::update_stress(Particles<2>& p, const std::vector<int>
   for (int k = 0; k < n; ++k) {
     const int i = members[k];
     p.nonlocal_strain[i] = averaged[k];
-    const Stresses st = principal_stresses(p.effective_stress[i], p.effective_stress_zz[i], stiffness(i));
+    const double stiffness = modulus_scale(p, i);
+    const Stresses st = principal_stresses(p.effective_stress[i], p.effective_stress_zz[i], stiffness);
     const double d = std::clamp(std::max({p.damage[i], nonlocal_tensile_damage(averaged[k]),
-                                          shear_damage(st, scale(i), stiffness(i))}),
+                                          shear_damage(st, strength_scale(p, i), stiffness)}),
                                 0.0, 1.0);
-    const Dissipation r = settle(i, d);
+    const Dissipation r = settle(p, i, d);
     plastic += r.plastic;
     damaged += r.damage;
   }
@@ -272,11 +290,10 @@ Dissipation ElasticDamage::update_stress(Particles<2>& p, const std::vector<int>
 }
 
 double ElasticDamage::strain_energy(const Particles<2>& p, const std::vector<int>& members) const {
-  const bool heterogeneous = parameters_.heterogeneity.has_value();
   return sum_over(members, [&](int i) {
     return 0.5 * p.volume[i] *
            compliance_product(p.stress[i], p.stress_zz[i], p.effective_stress[i], p.effective_stress_zz[i]) /
-           (heterogeneous ? p.modulus_scale[i] : 1.0);
+           modulus_scale(p, i);
   });
 }
 

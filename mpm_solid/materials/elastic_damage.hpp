@@ -96,6 +96,9 @@ class ElasticDamage final : public Material {
   ElasticDamage(std::string name, Elasticity elasticity, DamageParameters damage);
   void create_fields(Particles<2>& p, const std::vector<int>& members) const override;
   Dissipation update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const override;
+  Dissipation update_chunk(Particles<2>& p, std::span<const int> members, double dt) const override;
+  // Nonlocal damage reads the neighbours' strains.
+  bool pointwise() const override { return !parameters_.internal_length; }
   // Damage of one particle, given its history value, effective stress and
   // factors on the strengths and the moduli.
   double damage(double previous, const Mat<2>& effective, double effective_zz, double scale = 1.0,
@@ -109,6 +112,13 @@ class ElasticDamage final : public Material {
   double alpha_, k0_;       // Drucker-Prager friction cone (outer fit), intact cohesion
   double sin_phi_, cos_phi_, ucs_;  // of the Mohr-Coulomb shear criterion
 
+  double strength_scale(const Particles<2>& p, int i) const;  // s_f, 1 unless heterogeneous
+  double modulus_scale(const Particles<2>& p, int i) const;   // s_E
+  // The elastic trial of particle i's undamaged stress over dt.
+  void trial(Particles<2>& p, int i, double dt) const;
+  // Sets particle i's damage to d (no less than it had) and its acting
+  // stress, and returns what that dissipated.
+  Dissipation settle(Particles<2>& p, int i, double d) const;
   struct Stresses;  // ordered principal stresses, with the strains they hold
   Stresses principal_stresses(const Mat<2>& effective, double effective_zz, double stiffness) const;
   double shear_damage(const Stresses& s, double scale, double stiffness) const;
