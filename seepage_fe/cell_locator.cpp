@@ -33,6 +33,16 @@ CellLocator::CellLocator(const Mesh& mesh) : mesh_(mesh) {
     }
     box_lower_.push_back(clo);
     box_upper_.push_back(chi);
+    const q1::Corners x = mesh.corners(c);
+    // x0 - x1 + x2 - x3 is the bilinear term's coefficient (times 4): zero,
+    // to roundoff, for a parallelogram.
+    if ((x[0] - x[1] + x[2] - x[3]).lpNorm<Eigen::Infinity>() <= 1e-12 * (chi - clo).maxCoeff()) {
+      Eigen::Matrix2d jacobian;  // d(x, y) / d(xi, eta), constant
+      jacobian << 0.5 * (x[1] - x[0]), 0.5 * (x[3] - x[0]);
+      affine_.push_back(Affine{0.25 * (x[0] + x[1] + x[2] + x[3]), jacobian.inverse()});
+    } else {
+      affine_.emplace_back();
+    }
     const auto index = [&](const Eigen::Vector2d& p, int axis, int n) {
       return std::clamp(static_cast<int>((p[axis] - lower_[axis]) / bucket_size_[axis]), 0, n - 1);
     };
@@ -47,9 +57,17 @@ CellLocator::CellLocator(const Mesh& mesh) : mesh_(mesh) {
   }
 }
 
+std::optional<Eigen::Vector2d> CellLocator::reference(std::size_t c, const Eigen::Vector2d& point) const {
+  if (!affine_[c]) return q1::inverse_map(mesh_.corners(c), point);
+  // The acceptance of q1::inverse_map: a point on a shared edge is found.
+  const Eigen::Vector2d ref = affine_[c]->inverse_jacobian * (point - affine_[c]->centre);
+  if (ref.lpNorm<Eigen::Infinity>() > 1 + 1e-9) return std::nullopt;
+  return ref.cwiseMax(-1.0).cwiseMin(1.0);
+}
+
 std::optional<CellLocator::Hit> CellLocator::locate(const Eigen::Vector2d& point, int* hint) const {
   if (hint && *hint >= 0 && static_cast<std::size_t>(*hint) < mesh_.num_cells())
-    if (const auto ref = q1::inverse_map(mesh_.corners(static_cast<std::size_t>(*hint)), point))
+    if (const auto ref = reference(static_cast<std::size_t>(*hint), point))
       return Hit{*hint, *ref};
   const Eigen::Vector2d rel = (point - lower_).cwiseQuotient(bucket_size_);
   const double tol = 1e-9;
@@ -65,7 +83,7 @@ std::optional<CellLocator::Hit> CellLocator::locate(const Eigen::Vector2d& point
     if ((point.array() < (box_lower_[c] - slack).array()).any() ||
         (point.array() > (box_upper_[c] + slack).array()).any())
       continue;
-    if (const auto ref = q1::inverse_map(mesh_.corners(c), point)) {
+    if (const auto ref = reference(c, point)) {
       if (hint) *hint = cell;
       return Hit{cell, *ref};
     }

@@ -34,6 +34,17 @@ class CellLocator {
   std::vector<int> bucket_start_;  // CSR layout: cells of bucket b are
   std::vector<int> bucket_cells_;  // bucket_cells_[bucket_start_[b] .. bucket_start_[b+1])
   std::vector<Eigen::Vector2d> box_lower_, box_upper_;  // bounding box per cell
+  // A parallelogram's map to the reference square is affine: its reference
+  // coordinates are inverse_jacobian (x - centre), with no Newton iteration.
+  // Coupled runs locate every particle every step, and most meshes are of
+  // such cells (structured and transfinite ones all are).
+  struct Affine {
+    Eigen::Vector2d centre;
+    Eigen::Matrix2d inverse_jacobian;
+  };
+  std::vector<std::optional<Affine>> affine_;
+  // The reference coordinates of point in cell c, or nullopt outside it.
+  std::optional<Eigen::Vector2d> reference(std::size_t c, const Eigen::Vector2d& point) const;
 };
 
 }  // namespace outburst::seepage

@@ -187,7 +187,70 @@ TEST_CASE("points are located in small cells far from the origin", "[seepage][me
       Eigen::Vector2d back = Eigen::Vector2d::Zero();
       for (int a = 0; a < 4; ++a) back += n[a] * m.nodes[c[a]];
       CHECK((back - x).norm() < 1e-9 * cell + 1e-13 * std::abs(far));
+      // The locator maps these rectangles directly; Newton's map, which
+      // other cells take, must find the points too.
+      const auto newton = q1::inverse_map(m.corners(static_cast<std::size_t>(hit->cell)), x);
+      REQUIRE(newton);
+      CHECK((*newton - hit->reference).lpNorm<Eigen::Infinity>() < 1e-9);
     }
   INFO("cells of " << cell << " m by " << aspect * cell << " m at " << far << " m");
   CHECK(found == points);
+}
+
+TEST_CASE("parallelograms are located by their affine map, other cells by Newton's, with the same answers",
+          "[seepage][mesh]") {
+  // A structured mesh, sheared into parallelograms, with every other interior
+  // node moved off the grid: cells of both kinds side by side.
+  StructuredMeshSpec spec;
+  spec.size = {4, 2};
+  spec.cells = {8, 4};
+  spec.regions = {{"all", true, {}, {}}};
+  Mesh m = make_structured_mesh(spec);
+  for (auto& x : m.nodes) x.x() += 0.3 * x.y();
+  int moved = 0;
+  for (std::size_t k = 0; k < m.nodes.size(); ++k) {
+    auto& x = m.nodes[k];
+    const bool interior = x.y() > 1e-9 && x.y() < 2 - 1e-9 && x.x() - 0.3 * x.y() > 1e-9 &&
+                          x.x() - 0.3 * x.y() < 4 - 1e-9;
+    if (interior && k % 3 == 0) {
+      x += Eigen::Vector2d(0.07, -0.05);
+      ++moved;
+    }
+  }
+  REQUIRE(moved > 0);
+  const CellLocator locator(m);
+  int parallelograms = 0, general = 0;
+  for (std::size_t c = 0; c < m.num_cells(); ++c) {
+    const q1::Corners x = m.corners(c);
+    ((x[0] - x[1] + x[2] - x[3]).norm() < 1e-12 ? parallelograms : general)++;
+    // Points at and inside the cell's corners and edges, mapped forward.
+    for (const double xi : {-1.0, -0.6, 0.0, 0.999, 1.0})
+      for (const double eta : {-1.0, -0.3, 0.5, 1.0}) {
+        const auto n = q1::shape(xi, eta);
+        Eigen::Vector2d point = Eigen::Vector2d::Zero();
+        for (int a = 0; a < 4; ++a) point += n[a] * x[a];
+        int hint = static_cast<int>(c);
+        const auto hit = locator.locate(point, &hint);
+        REQUIRE(hit);
+        CHECK(hit->cell == static_cast<int>(c));
+        CHECK((hit->reference - Eigen::Vector2d(xi, eta)).lpNorm<Eigen::Infinity>() < 1e-12);
+        // Without a hint the bucket search finds a cell holding the point.
+        const auto found = locator.locate(point);
+        REQUIRE(found);
+        const auto back = q1::shape(found->reference.x(), found->reference.y());
+        Eigen::Vector2d mapped = Eigen::Vector2d::Zero();
+        for (int a = 0; a < 4; ++a) mapped += back[a] * m.corners(static_cast<std::size_t>(found->cell))[a];
+        CHECK((mapped - point).norm() < 1e-12);
+      }
+    // Just outside each edge's midpoint: not in this cell.
+    const Eigen::Vector2d centre = 0.25 * (x[0] + x[1] + x[2] + x[3]);
+    for (int a = 0; a < 4; ++a) {
+      const Eigen::Vector2d mid = 0.5 * (x[a] + x[(a + 1) % 4]);
+      int hint = static_cast<int>(c);
+      const auto hit = locator.locate(mid + 1e-6 * (mid - centre), &hint);
+      if (hit) CHECK(hit->cell != static_cast<int>(c));
+    }
+  }
+  CHECK(parallelograms > 0);
+  CHECK(general > 0);
 }
