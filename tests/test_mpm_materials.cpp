@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <set>
 
 #include "mpm_solid/materials/drucker_prager.hpp"
 #include "mpm_solid/materials/elastic.hpp"
@@ -311,6 +313,47 @@ TEST_CASE("heterogeneous coal: a particle's damage starts at its own share of th
     CHECK(p.strength_scale[k] == (k % 2 ? weibull_strength_scale(*d.heterogeneity, p.id[k]) : 1.0));
     CHECK(p.modulus_scale[k] == (k % 2 ? weibull_modulus_scale(*d.heterogeneity, p.id[k]) : 1.0));
   }
+}
+
+TEST_CASE("heterogeneous coal with a grain size: particles share their grain's draws, at every spacing",
+          "[mpm][material][damage][heterogeneity]") {
+  DamageParameters d = coal_damage;
+  d.heterogeneity = DamageParameters::Heterogeneity{3.0, 5, std::nullopt, 0.25};
+  ElasticDamage m("coal", coal, d);
+  // Two fills of the same 2 m x 1 m block, below and right of the origin,
+  // at spacings of 1/12 and 1/16 m (1/6 and 1/8 m cells, 4 per cell): the
+  // factors at a point are its grain's, whichever fill it is in.
+  std::map<std::pair<int, int>, std::pair<double, double>> grains;
+  int grains_seen_twice = 0;
+  for (const int per_metre : {12, 16}) {
+    Particles<2> p;
+    std::vector<int> members;
+    for (int i = 0; i < 2 * per_metre; ++i)
+      for (int j = 0; j < per_metre; ++j) {
+        const Vec<2> x((i + 0.5) / per_metre - 1.0, (j + 0.5) / per_metre - 1.0);
+        members.push_back(static_cast<int>(p.size()));
+        p.add(x, {0, 0}, 1, 1, 0.5, Mat<2>::Zero(), 0, 0);
+      }
+    m.create_fields(p, members);
+    for (const int k : members) {
+      const std::pair<int, int> grain{static_cast<int>(std::floor(p.x0[k][0] / 0.25)),
+                                      static_cast<int>(std::floor(p.x0[k][1] / 0.25))};
+      const auto [at, first] = grains.try_emplace(grain, p.strength_scale[k], p.modulus_scale[k]);
+      CHECK(p.strength_scale[k] == at->second.first);
+      CHECK(p.modulus_scale[k] == at->second.second);
+      grains_seen_twice += per_metre == 16 && !first;
+    }
+  }
+  REQUIRE(grains.size() == 8 * 4);
+  CHECK(grains_seen_twice > 0);
+  // Grains draw apart: no two of the 32 share a factor.
+  std::set<double> strengths;
+  for (const auto& [grain, factors] : grains) strengths.insert(factors.first);
+  CHECK(strengths.size() == grains.size());
+  // Without a grain size each particle draws its own, by id.
+  CHECK(DamageParameters::Heterogeneity{3.0, 5}.key(17, Vec<2>(0.1, 0.1)) == 17);
+  CHECK(d.heterogeneity->key(17, Vec<2>(0.1, 0.1)) == d.heterogeneity->key(18, Vec<2>(0.2, 0.2)));
+  CHECK(d.heterogeneity->key(17, Vec<2>(0.1, 0.1)) != d.heterogeneity->key(17, Vec<2>(-0.1, 0.1)));
 }
 
 TEST_CASE("heterogeneous coal: a particle's modulus factor sets its wave speed, and the stiffest sets the stable step",

@@ -103,15 +103,22 @@ double weibull_modulus_scale(const DamageParameters::Heterogeneity& h, std::int6
   return weibull(h.modulus_index(), mix(strength_bits(h, id)));
 }
 
+std::int64_t DamageParameters::Heterogeneity::key(std::int64_t id, const Vec<2>& x0) const {
+  if (!grain_size) return id;
+  const auto index = [&](double x) { return static_cast<std::uint32_t>(static_cast<std::int32_t>(std::floor(x / *grain_size))); };
+  return static_cast<std::int64_t>((static_cast<std::uint64_t>(index(x0[0])) << 32) | index(x0[1]));
+}
+
 void ElasticDamage::create_fields(Particles<2>& p, const std::vector<int>& members) const {
   p.need_plastic_strain();
   p.need_damage();
   if (parameters_.internal_length) p.need("nonlocal damage");
   if (!parameters_.heterogeneity) return;
   p.need("heterogeneity");
+  const auto& h = *parameters_.heterogeneity;
   for (const int i : members) {
-    p.strength_scale[i] = weibull_strength_scale(*parameters_.heterogeneity, p.id[i]);
-    p.modulus_scale[i] = weibull_modulus_scale(*parameters_.heterogeneity, p.id[i]);
+    p.strength_scale[i] = weibull_strength_scale(h, h.key(p.id[i], p.x0[i]));
+    p.modulus_scale[i] = weibull_modulus_scale(h, h.key(p.id[i], p.x0[i]));
   }
 }
 
@@ -383,7 +390,16 @@ std::unique_ptr<Material> read(const scene::Table& m, const MaterialContext& c) 
         h->number({"modulus_homogeneity_index", "Weibull shape m_E of the elastic moduli, drawn apart from the "
                                                 "strengths (default: the homogeneity_index); the stiffest particle "
                                                 "sets the stable step",
-                   same_as_strength, Range::at_least(1)})};
+                   same_as_strength, Range::at_least(1)}),
+        h->has("grain_size")
+            ? std::optional(h->quantity({"grain_size", "side of the squares of coal that share one draw (a grid "
+                                                       "through the origin): the random field's correlation "
+                                                       "length, so that refining the particles keeps the same "
+                                                       "coal; without it each particle draws its own, and a finer "
+                                                       "grid makes a finer-grained coal",
+                                         "", Range::positive()},
+                                        units::length))
+            : std::nullopt};
   }
   return std::make_unique<ElasticDamage>(c.name, c.elasticity, d);
 }

@@ -72,11 +72,21 @@ struct DamageParameters {
   // a crack band G_f then scales by s_f^2 / s_E, so every particle keeps the
   // characteristic length E G_f / f_t^2 and the band's snap-back limit holds
   // for all alike.
+  // Each particle draws its own factors unless a grain size is given: the
+  // random field's correlation length is then the particle spacing, so a
+  // finer grid makes another, finer-grained coal. With a grain size g [m]
+  // the particles whose initial positions lie in one g x g square of a grid
+  // through the origin share its draw (the square's indices replace the
+  // particle's id in the hash), and every resolution finer than g sees the
+  // same coal.
   struct Heterogeneity {
     double homogeneity_index;
     std::uint64_t seed;
     std::optional<double> modulus_homogeneity_index = std::nullopt;
+    std::optional<double> grain_size = std::nullopt;
     double modulus_index() const { return modulus_homogeneity_index.value_or(homogeneity_index); }
+    // What the draws of a particle of this id, at x0 at t = 0, are hashed from.
+    std::int64_t key(std::int64_t id, const Vec<2>& x0) const;
   };
   std::optional<Heterogeneity> heterogeneity = std::nullopt;
 };
