@@ -458,6 +458,25 @@ def outburst_convergence(rows):
     return lines[:-1]
 
 
+def ensemble_block(rows):
+    from .outburst.convergence import QUANTITIES, ensemble_table
+    numeric = [k for k, _ in QUANTITIES] + ["seed", "homogeneity", "time_s", "grain_size_m"]
+    rows = [{k: (float(v) if k in numeric and v else v) for k, v in r.items()} for r in rows]
+    lines = []
+    for time in sorted({r["time_s"] for r in rows if not r.get("failure")}):
+        for law in dict.fromkeys(r["law"] for r in rows):
+            first = next(r for r in rows if r["law"] == law)
+            lines += [line.replace("### ", "#### ") for line in
+                      ensemble_table(rows, law, time, first["homogeneity"], grain=first.get("grain_size_m") or None)]
+            lines.append("")
+    return lines[:-1]
+
+
+@block("outburst convergence ensemble", "cases/outburst/convergence/convergence_ensemble.csv")
+def outburst_convergence_ensemble(rows):
+    return ensemble_block(rows)
+
+
 @block("outburst fracture sensitivity", "cases/outburst/convergence/sensitivity.csv")
 def outburst_fracture_sensitivity(rows):
     from .outburst.sensitivity import table

@@ -144,14 +144,15 @@ def measured(run, run_dir, row, times):
     return [row | {"time_s": time, "particles": particles} | headline(run_dir, time) for time in times]
 
 
-def ensemble_table(rows, law, time, homogeneity, failures=True):
+def ensemble_table(rows, law, time, homogeneity, failures=True, grain=None):
     """Markdown: each quantity's mean and 95 % interval over the seeds, by cell
     (coarsest first), and whether the two finest cells' means differ
     (Welch's t-test at 5 %: the seeds are independent draws at each cell)."""
     from scipy import stats
     from .ensemble import summary
     cells = sorted({r["cell"] for r in rows if r["law"] == law}, key=lambda c: -Fraction(c.split()[0]))
-    lines = [f"### {law.replace('_', ' ')}, heterogeneous coal (m = {homogeneity:g}), t = {time:g} s", "",
+    draws = "a draw per particle" if grain is None else f"a draw per {grain:g} m grain"
+    lines = [f"### {law.replace('_', ' ')}, heterogeneous coal (m = {homogeneity:g}, {draws}), t = {time:g} s", "",
              "| quantity | " + " | ".join(f"{c} (seeds)" for c in cells) +
              (" | two finest differ (Welch's t-test at 5 %) |" if len(cells) > 1 else " |"),
              "|---|" + "---|" * len(cells) + ("---|" if len(cells) > 1 else "")]
@@ -169,7 +170,9 @@ def ensemble_table(rows, law, time, homogeneity, failures=True):
                 line += " | " + ("no" if a[0] == b[0] else "yes")
             else:
                 p = stats.ttest_ind(a, b, equal_var=False).pvalue
-                line += f" | {'yes' if p < 0.05 else 'no'}: means {abs(np.mean(a) - np.mean(b)):.3g} apart, p = {p:.2g}"
+                apart = abs(np.mean(a) - np.mean(b))
+                share = f" ({100 * apart / abs(np.mean(b)):.1f} % of the finer's)" if np.mean(b) else ""
+                line += f" | {'yes' if p < 0.05 else 'no'}: means {apart:.3g} apart{share}, p = {p:.2g}"
         lines.append(line + " |")
     if failures:
         lines += [f"\n{r['cell']}, seed {r['seed']}: {r['failure']}"
@@ -190,6 +193,9 @@ def main():
     ap.add_argument("--seeds", type=int, default=0,
                     help="heterogeneous coal: an ensemble of this many seeds at each cell (0: uniform coal)")
     ap.add_argument("--homogeneity", type=float, default=3.0, help="the ensembles' Weibull shape m")
+    ap.add_argument("--grain-size", type=Fraction,
+                    help="side [m] of the squares of coal that share a draw (heterogeneity.grain_size), as a "
+                         "fraction; without it each particle draws its own, and each cell another coal")
     ap.add_argument("--jobs", type=int, default=1, help="an ensemble's runs side by side (cores / jobs threads each)")
     ap.add_argument("--resume", action="store_true", help="keep the runs an earlier study finished")
     ap.add_argument("--measure-only", action="store_true",
@@ -197,11 +203,14 @@ def main():
     args = ap.parse_args()
     if args.seeds < 0 or args.homogeneity < 1 or args.jobs < 1:
         ap.error("--seeds must be at least 0, --homogeneity and --jobs at least 1")
+    if args.grain_size is not None and (args.grain_size <= 0 or not args.seeds):
+        ap.error("--grain-size must be positive, and needs --seeds")
     os.makedirs(args.out, exist_ok=True)
     cells = [Fraction(c) for c in args.cells]
     cores = os.cpu_count() or 1
     jobs = min(args.jobs, cores, max(args.seeds, 1))
     threads = max(1, cores // jobs)
+    grain = "" if args.grain_size is None else f"_g{args.grain_size.numerator}_{args.grain_size.denominator}"
     rows = []
     for law in args.laws:
         scene = scene_for(law, args.out)
@@ -219,27 +228,31 @@ def main():
                 continue
             # An ensemble at this cell: the same seeds at every cell (though
             # another cell draws another coal: the draw follows the particles).
-            members = [(seed, os.path.join(args.out, f"{name}_m{args.homogeneity:g}_seed_{seed:03d}"),
+            grain_key = "" if args.grain_size is None else f', grain_size="{float(args.grain_size)!r} m"'
+            members = [(seed, os.path.join(args.out, f"{name}_m{args.homogeneity:g}{grain}_seed_{seed:03d}"),
                         overrides + [f"mpm.materials[0].heterogeneity={{homogeneity_index={args.homogeneity:g}, "
-                                     f"seed={seed}}}"]) for seed in range(1, args.seeds + 1)]
+                                     f"seed={seed}{grain_key}}}"]) for seed in range(1, args.seeds + 1)]
             with concurrent.futures.ThreadPoolExecutor(max_workers=jobs) as pool:
                 runs = list(pool.map(lambda m: kept_or_run(args, law, scene, m[2], m[1], f"{label}, seed {m[0]}",
                                                            threads), members))
             for (seed, run_dir, _), run in zip(members, runs):
-                rows += measured(run, run_dir, row | {"seed": seed, "homogeneity": args.homogeneity}, args.at)
+                rows += measured(run, run_dir, row | {"seed": seed, "homogeneity": args.homogeneity,
+                                                      "grain_size_m": "" if args.grain_size is None
+                                                      else float(args.grain_size)}, args.at)
                 print(f"{law}, {label}, seed {seed}: {rows[-1]}", flush=True)
     if not args.seeds:
         write_rows(os.path.join(args.out, "convergence.csv"), rows)
         print("\n".join(write(rows, args.laws, args.at, args.out)))
         return
-    write_rows(os.path.join(args.out, "convergence_ensemble.csv"), rows)
+    write_rows(os.path.join(args.out, f"convergence_ensemble{grain}.csv"), rows)
     lines = ["# Outburst: convergence with resolution over heterogeneous coal", "",
              f"An ensemble of {args.seeds} seeds at each cell: each quantity's mean +- the 95 % interval of the mean "
              "(Student t), with the number of seeds that finished.", ""]
     for k, time in enumerate(args.at):
         for law in args.laws:
-            lines += ensemble_table(rows, law, time, args.homogeneity, failures=k == 0) + [""]
-    with open(os.path.join(args.out, "convergence_ensemble.md"), "w") as f:
+            lines += ensemble_table(rows, law, time, args.homogeneity, failures=k == 0,
+                                    grain=None if args.grain_size is None else float(args.grain_size)) + [""]
+    with open(os.path.join(args.out, f"convergence_ensemble{grain}.md"), "w") as f:
         f.write("\n".join(lines))
     print("\n".join(lines))
 
