@@ -477,6 +477,11 @@ def outburst_convergence_ensemble(rows):
     return ensemble_block(rows)
 
 
+@block("outburst convergence ensemble, grains", "cases/outburst/convergence/convergence_ensemble_g1_4.csv")
+def outburst_convergence_ensemble_grains(rows):
+    return ensemble_block(rows)
+
+
 @block("outburst fracture sensitivity", "cases/outburst/convergence/sensitivity.csv")
 def outburst_fracture_sensitivity(rows):
     from .outburst.sensitivity import table

@@ -175,8 +175,9 @@ def ensemble_table(rows, law, time, homogeneity, failures=True, grain=None):
                 line += f" | {'yes' if p < 0.05 else 'no'}: means {apart:.3g} apart{share}, p = {p:.2g}"
         lines.append(line + " |")
     if failures:
-        lines += [f"\n{r['cell']}, seed {r['seed']}: {r['failure']}"
-                  for r in rows if r["law"] == law and r.get("failure")]
+        for r in rows:
+            if r["law"] == law and r.get("failure"):
+                lines += ["", f"{r['cell']}, seed {int(r['seed'])}: {r['failure']}"]
     return lines
 
 
