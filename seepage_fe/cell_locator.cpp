@@ -65,10 +65,14 @@ std::optional<Eigen::Vector2d> CellLocator::reference(std::size_t c, const Eigen
   return ref.cwiseMax(-1.0).cwiseMin(1.0);
 }
 
+CellLocator::Hit CellLocator::hit(std::size_t c, const Eigen::Vector2d& reference) const {
+  return {static_cast<int>(c), reference, affine_[c] ? &affine_[c]->inverse_jacobian : nullptr};
+}
+
 std::optional<CellLocator::Hit> CellLocator::locate(const Eigen::Vector2d& point, int* hint) const {
   if (hint && *hint >= 0 && static_cast<std::size_t>(*hint) < mesh_.num_cells())
     if (const auto ref = reference(static_cast<std::size_t>(*hint), point))
-      return Hit{*hint, *ref};
+      return hit(static_cast<std::size_t>(*hint), *ref);
   const Eigen::Vector2d rel = (point - lower_).cwiseQuotient(bucket_size_);
   const double tol = 1e-9;
   if (rel.x() < -tol || rel.y() < -tol || rel.x() > nx_ + tol || rel.y() > ny_ + tol)
@@ -85,7 +89,7 @@ std::optional<CellLocator::Hit> CellLocator::locate(const Eigen::Vector2d& point
       continue;
     if (const auto ref = reference(c, point)) {
       if (hint) *hint = cell;
-      return Hit{cell, *ref};
+      return hit(c, *ref);
     }
   }
   return std::nullopt;

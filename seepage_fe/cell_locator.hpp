@@ -20,6 +20,9 @@ class CellLocator {
   struct Hit {
     int cell;
     Eigen::Vector2d reference;  // coordinates in [-1, 1]^2
+    // d(xi, eta) / d(x, y) of a parallelogram, constant over the cell; null
+    // for other cells. Samplers take gradients from it without a Jacobian.
+    const Eigen::Matrix2d* inverse_jacobian = nullptr;
   };
   // `hint`, if given, is a cell to try first (where the point was last time);
   // it is updated to the cell found. Any hint is safe: a wrong one costs one test.
@@ -45,6 +48,7 @@ class CellLocator {
   std::vector<std::optional<Affine>> affine_;
   // The reference coordinates of point in cell c, or nullopt outside it.
   std::optional<Eigen::Vector2d> reference(std::size_t c, const Eigen::Vector2d& point) const;
+  Hit hit(std::size_t c, const Eigen::Vector2d& reference) const;
 };
 
 }  // namespace outburst::seepage

@@ -64,6 +64,25 @@ Sample sample(const Corners& x, const std::array<int, 4>& nodes, const Nodal& u,
   return s;
 }
 
+// The same on a parallelogram, whose inverse Jacobian d(xi, eta) / d(x, y) is
+// constant and known: no Jacobian to build and invert per point (coupled runs
+// sample the pressure at every particle every MPM step).
+template <class Nodal>
+Sample sample_affine(const std::array<int, 4>& nodes, const Nodal& u, const Eigen::Vector2d& reference,
+                     const Eigen::Matrix2d& inverse_jacobian) {
+  const double xi = reference.x(), eta = reference.y();
+  Sample s{0.0, Eigen::Vector2d::Zero()};
+  Eigen::Vector2d along_reference = Eigen::Vector2d::Zero();  // d u / d(xi, eta)
+  for (int a = 0; a < 4; ++a) {
+    const double ua = u[nodes[a]];
+    s.value += 0.25 * (1 + corner_xi[a] * xi) * (1 + corner_eta[a] * eta) * ua;
+    along_reference += Eigen::Vector2d(0.25 * corner_xi[a] * (1 + corner_eta[a] * eta),
+                                       0.25 * corner_eta[a] * (1 + corner_xi[a] * xi)) * ua;
+  }
+  s.gradient = inverse_jacobian.transpose() * along_reference;
+  return s;
+}
+
 // 2x2 Gauss rule, exact for the bilinear stiffness on parallelograms.
 inline constexpr double gauss2 = 0.57735026918962576451;  // 1/sqrt(3)
 inline constexpr std::array<std::array<double, 2>, 4> gauss2_points{

@@ -13,7 +13,9 @@ std::optional<Sampler::Value> Sampler::sample(const Eigen::VectorXd& nodal, cons
   const auto hit = locator_.locate(x, hint);
   if (!hit) return std::nullopt;
   const auto c = static_cast<std::size_t>(hit->cell);
-  const auto s = q1::sample(mesh_.corners(c), mesh_.cells[c], nodal, hit->reference);
+  const auto s = hit->inverse_jacobian
+                     ? q1::sample_affine(mesh_.cells[c], nodal, hit->reference, *hit->inverse_jacobian)
+                     : q1::sample(mesh_.corners(c), mesh_.cells[c], nodal, hit->reference);
   return Value{s.value, s.gradient};
 }
 

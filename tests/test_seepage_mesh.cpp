@@ -4,6 +4,7 @@
 #include <fstream>
 
 #include "seepage_fe/cell_locator.hpp"
+#include "seepage_fe/sampling.hpp"
 #include "seepage_fe/mesh.hpp"
 #include "seepage_fe/q1.hpp"
 
@@ -197,10 +198,11 @@ TEST_CASE("points are located in small cells far from the origin", "[seepage][me
   CHECK(found == points);
 }
 
-TEST_CASE("parallelograms are located by their affine map, other cells by Newton's, with the same answers",
-          "[seepage][mesh]") {
-  // A structured mesh, sheared into parallelograms, with every other interior
-  // node moved off the grid: cells of both kinds side by side.
+namespace {
+
+// A structured mesh, sheared into parallelograms, with every third interior
+// node moved off the grid: cells of both kinds side by side.
+Mesh sheared_mesh_with_moved_nodes() {
   StructuredMeshSpec spec;
   spec.size = {4, 2};
   spec.cells = {8, 4};
@@ -218,6 +220,14 @@ TEST_CASE("parallelograms are located by their affine map, other cells by Newton
     }
   }
   REQUIRE(moved > 0);
+  return m;
+}
+
+}  // namespace
+
+TEST_CASE("parallelograms are located by their affine map, other cells by Newton's, with the same answers",
+          "[seepage][mesh]") {
+  const Mesh m = sheared_mesh_with_moved_nodes();
   const CellLocator locator(m);
   int parallelograms = 0, general = 0;
   for (std::size_t c = 0; c < m.num_cells(); ++c) {
@@ -253,4 +263,33 @@ TEST_CASE("parallelograms are located by their affine map, other cells by Newton
   }
   CHECK(parallelograms > 0);
   CHECK(general > 0);
+}
+
+TEST_CASE("a field sampled in a parallelogram by its constant inverse Jacobian equals the isoparametric sample",
+          "[seepage][mesh]") {
+  const Mesh m = sheared_mesh_with_moved_nodes();
+  const Sampler sampler(m);
+  // A field with no special form: neither linear nor bilinear in x and y.
+  Eigen::VectorXd u(static_cast<Eigen::Index>(m.num_nodes()));
+  for (std::size_t k = 0; k < m.num_nodes(); ++k)
+    u[static_cast<Eigen::Index>(k)] = std::sin(3 * m.nodes[k].x()) + m.nodes[k].y() * m.nodes[k].y();
+  int affine = 0;
+  for (std::size_t c = 0; c < m.num_cells(); ++c) {
+    const q1::Corners x = m.corners(c);
+    for (const double xi : {-1.0, -0.4, 0.3, 1.0})
+      for (const double eta : {-1.0, 0.2, 0.9}) {
+        const auto n = q1::shape(xi, eta);
+        Eigen::Vector2d point = Eigen::Vector2d::Zero();
+        for (int a = 0; a < 4; ++a) point += n[a] * x[a];
+        int hint = static_cast<int>(c);
+        const auto got = sampler.sample(u, point, &hint);
+        REQUIRE(got);
+        REQUIRE(hint == static_cast<int>(c));
+        const auto expected = q1::sample(x, m.cells[c], u, Eigen::Vector2d(xi, eta));
+        CHECK(std::abs(got->value - expected.value) < 1e-12);
+        CHECK((got->gradient - expected.gradient).norm() < 1e-11 * (1 + expected.gradient.norm()));
+        affine += (x[0] - x[1] + x[2] - x[3]).norm() < 1e-12;
+      }
+  }
+  CHECK(affine > 0);
 }
