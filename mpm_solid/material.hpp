@@ -50,10 +50,16 @@ class Material {
  public:
   virtual ~Material() = default;
   explicit Material(std::string name, Elasticity elasticity)
-      : name_(std::move(name)), elasticity_(elasticity) {}
+      : name_(std::move(name)),
+        elasticity_(elasticity),
+        lambda_(elasticity.lame_lambda()),
+        shear_(elasticity.shear_modulus()) {}
 
   const std::string& name() const { return name_; }
   const Elasticity& elasticity() const { return elasticity_; }
+  // The Lame constants, divided out once: the updates read them per particle.
+  double lame_lambda() const { return lambda_; }
+  double shear_modulus() const { return shear_; }
 
   // Creates the optional particle fields the model keeps (plastic strain,
   // damage) and sets those of its own particles, `members`; the solver calls
@@ -86,6 +92,7 @@ class Material {
  private:
   std::string name_;
   Elasticity elasticity_;
+  double lambda_, shear_;
 };
 
 // What a model's reader has beyond its own keys: the material's name and the
@@ -115,17 +122,17 @@ const std::vector<MaterialModel>& material_models();
 bool register_material(const MaterialModel& model);
 
 // The elastic trial step shared by the elastic-plastic models: Jaumann-rate
-// linear elasticity over dt, in place.
+// linear elasticity with Lame constants lambda and G over dt, in place.
 // Inline, with the other kernels below, so that each model's update compiles
 // them into its own loop.
-inline void elastic_trial(const Elasticity& e, const Mat<2>& l, double dt, Mat<2>& s, double& s_zz) {
+inline void elastic_trial(double lambda, double shear, const Mat<2>& l, double dt, Mat<2>& s, double& s_zz) {
   const Mat<2> d = 0.5 * (l + l.transpose());  // rate of deformation
   const Mat<2> w = 0.5 * (l - l.transpose());  // spin
   const double trace = d.trace();               // plane strain: d_zz = 0
   // sigma' = sigma + dt (C : D + W sigma - sigma W)
   const Mat<2> rotation = w * s - s * w;
-  s += dt * (e.lame_lambda() * trace * Mat<2>::Identity() + 2 * e.shear_modulus() * d + rotation);
-  s_zz += dt * e.lame_lambda() * trace;
+  s += dt * (lambda * trace * Mat<2>::Identity() + 2 * shear * d + rotation);
+  s_zz += dt * lambda * trace;
 }
 
 // Mean stress and deviator of a plane-strain state (zz included in both).
@@ -146,7 +153,7 @@ inline Invariants invariants(const Mat<2>& s, double s_zz) {
 
 inline double Material::compliance_product(const Mat<2>& a, double a_zz, const Mat<2>& b, double b_zz) const {
   const auto ia = invariants(a, a_zz), ib = invariants(b, b_zz);
-  const double g = elasticity_.shear_modulus(), bulk = elasticity_.lame_lambda() + 2.0 / 3.0 * g;
+  const double g = shear_, bulk = lambda_ + 2.0 / 3.0 * g;
   const double deviatoric = ia.deviator.cwiseProduct(ib.deviator).sum() + ia.deviator_zz * ib.deviator_zz;
   return deviatoric / (2 * g) + ia.mean * ib.mean / bulk;
 }
@@ -201,8 +208,11 @@ template <class Update>
 Dissipation each_member(Particles<2>& p, std::span<const int> members, double dt, Update&& update) {
   Dissipation total;
   for (const int i : members) {
-    p.deformation[i] = (Mat<2>::Identity() + dt * p.velocity_gradient[i]) * p.deformation[i];
-    p.volume[i] = p.volume0[i] * p.deformation[i].determinant();
+    // Into a local first: the product evaluated straight into the particle's
+    // field goes through a temporary and back through memory.
+    const Mat<2> f = (Mat<2>::Identity() + dt * p.velocity_gradient[i]) * p.deformation[i];
+    p.deformation[i] = f;
+    p.volume[i] = p.volume0[i] * f.determinant();
     total += update(i);
   }
   return total;

@@ -268,19 +268,24 @@ void Solver::scatter_mass_momentum() {
   momenta.clear();
 #pragma omp parallel num_threads(threads_)
   {
-    auto& m = masses.buffer(omp_get_thread_num());
-    auto& mv = momenta.buffer(omp_get_thread_num());
+    double* m = masses.buffer(omp_get_thread_num()).data();
+    Vec<2>* mv = momenta.buffer(omp_get_thread_num()).data();
+    const Lattice<2> lattice(grid_);
     Stencil2<Shape> s;
 #pragma omp for schedule(static)
     for (int i = 0; i < n; ++i) {
-      s.template compute<Apic>(grid_, p.x[i], p.half_width[i]);
+      s.template compute<Apic>(lattice, p.x[i], p.half_width[i]);
+      // Read once: the compiler cannot tell the nodal sums from the
+      // particle's fields, and would load these again after every store.
+      const double mass = p.mass[i];
+      const Vec<2> v = p.v[i];
       for (int k = 0; k < s.count; ++k) {
-        const double wm = s.weight[k] * p.mass[i];
+        const double wm = s.weight[k] * mass;
         m[s.node[k]] += wm;
         if constexpr (Apic)
-          mv[s.node[k]] += wm * (p.v[i] + p.affine[i] * s.offset[k]);
+          mv[s.node[k]] += wm * (v + p.affine[i] * s.offset[k]);
         else
-          mv[s.node[k]] += wm * p.v[i];
+          mv[s.node[k]] += wm * v;
       }
     }
   }
@@ -327,10 +332,11 @@ void Solver::gather_velocity_gradient() {
   const int n = static_cast<int>(p.size());
 #pragma omp parallel
   {
+    const Lattice<2> lattice(grid_);
     Stencil2<Shape> s;
 #pragma omp for schedule(static)
     for (int i = 0; i < n; ++i) {
-      s.compute(grid_, p.x[i], p.half_width[i]);
+      s.compute(lattice, p.x[i], p.half_width[i]);
       p.velocity_gradient[i] = velocity_gradient_at(velocity_, s);
     }
   }
@@ -347,10 +353,11 @@ void Solver::smooth_dilatation() {
 #pragma omp parallel num_threads(threads_)
   {
     auto& weighted = sums.buffer(omp_get_thread_num());
+    const Lattice<2> lattice(grid_);
     Stencil2<Shape> s;
 #pragma omp for schedule(static)
     for (int i = 0; i < n; ++i) {
-      s.compute(grid_, p.x[i], p.half_width[i]);
+      s.compute(lattice, p.x[i], p.half_width[i]);
       const Vec<2> value(p.volume[i] * p.velocity_gradient[i].trace(), p.volume[i]);
       for (int k = 0; k < s.count; ++k) weighted[s.node[k]] += s.weight[k] * value;
     }
@@ -358,10 +365,11 @@ void Solver::smooth_dilatation() {
   sums.gather();
 #pragma omp parallel
   {
+    const Lattice<2> lattice(grid_);
     Stencil2<Shape> s;
 #pragma omp for schedule(static)
     for (int i = 0; i < n; ++i) {
-      s.compute(grid_, p.x[i], p.half_width[i]);
+      s.compute(lattice, p.x[i], p.half_width[i]);
       double smoothed = 0;
       for (int k = 0; k < s.count; ++k) {
         const Vec<2>& node = force_[s.node[k]];
@@ -391,10 +399,11 @@ void Solver::scatter_forces() {
 #pragma omp parallel num_threads(threads_)
   {
     auto& f = forces.buffer(omp_get_thread_num());
+    const Lattice<2> lattice(grid_);
     Stencil2<Shape> s;
 #pragma omp for schedule(static)
     for (int i = 0; i < n; ++i) {
-      s.compute(grid_, p.x[i], p.half_width[i]);
+      s.compute(lattice, p.x[i], p.half_width[i]);
       add_forces(p, terms, i, s, f);
     }
   }
@@ -419,6 +428,7 @@ void Solver::update_and_scatter(double dt) {
 #pragma omp parallel num_threads(threads_) reduction(+ : plastic, damage)
   {
     auto& f = forces.buffer(omp_get_thread_num());
+    const Lattice<2> lattice(grid_);
     std::vector<Stencil2<Shape>> stencils(chunk_size);
     for (std::size_t m = 0; m < materials_.size(); ++m) {
       const std::span<const int> members(members_[m]);
@@ -429,7 +439,7 @@ void Solver::update_and_scatter(double dt) {
       for (int c = 0; c < chunks; ++c) {
         const auto chunk = members.subspan(c * chunk_size, std::min(chunk_size, n - c * chunk_size));
         for (std::size_t k = 0; k < chunk.size(); ++k) {
-          stencils[k].compute(grid_, p.x[chunk[k]], p.half_width[chunk[k]]);
+          stencils[k].compute(lattice, p.x[chunk[k]], p.half_width[chunk[k]]);
           p.velocity_gradient[chunk[k]] = velocity_gradient_at(velocity_, stencils[k]);
         }
         const Dissipation d = materials_[m]->update_chunk(p, chunk, dt);
@@ -561,8 +571,11 @@ double Solver::apply_walls(std::vector<Vec<2>>& velocity) const {
       }
     }
   }
+  // Most of an obstacle's nodes lie deep in the rock, where no particle
+  // reaches: at rest, which every contact leaves at rest.
   for (const auto& o : obstacle_nodes_)
-    friction_work += constrain(velocity[o.node], o.normal, settings_.obstacles[o.obstacle].contact, mass_[o.node]);
+    if (const Vec<2>& v = velocity[o.node]; v.x() != 0 || v.y() != 0)
+      friction_work += constrain(velocity[o.node], o.normal, settings_.obstacles[o.obstacle].contact, mass_[o.node]);
   return friction_work;
 }
 
@@ -580,10 +593,11 @@ void Solver::gather_motion(double dt) {
   const bool loads = !lean_build && !p.external_force.empty();
 #pragma omp parallel reduction(merge : census) reduction(+ : lost, work, gained)
   {
+    const Lattice<2> lattice(grid_);
     Stencil2<Shape> s;
 #pragma omp for schedule(static)
     for (int i = 0; i < n; ++i) {
-      s.template compute<Apic>(grid_, p.x[i], p.half_width[i]);
+      s.template compute<Apic>(lattice, p.x[i], p.half_width[i]);
       Vec<2> v_pic = Vec<2>::Zero(), dv = Vec<2>::Zero();
       Mat<2> b = Mat<2>::Zero();
       Vec<2> d = Vec<2>::Zero();  // diagonal of D = sum w (x_i - x_p)(x_i - x_p)^T

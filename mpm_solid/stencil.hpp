@@ -8,6 +8,25 @@
 
 namespace outburst::mpm {
 
+// The grid's numbers a stencil needs, taken into a particle loop's locals
+// once per pass. Read through the grid instead, they would be loaded again
+// for every particle, and 1 / h divided again: the loop's stores into the
+// nodal and particle arrays might, for all the compiler knows, change them.
+template <int Dim>
+struct Lattice {
+  Vec<Dim> lower;
+  double h, inv_h;
+  std::array<int, Dim> nodes_along;  // ghosts included
+  explicit Lattice(const Grid<Dim>& g) : lower(g.lower), h(g.h), inv_h(1.0 / g.h) {
+    for (int d = 0; d < Dim; ++d) nodes_along[d] = g.nodes_along(d);
+  }
+  std::size_t index(const std::array<int, Dim>& i) const {
+    std::size_t flat = 0;
+    for (int d = Dim - 1; d >= 0; --d) flat = flat * static_cast<std::size_t>(nodes_along[d]) + i[d];
+    return flat;
+  }
+};
+
 template <int Dim, class Shape>
 struct Stencil {
   static constexpr int support = Shape::support;
@@ -22,21 +41,19 @@ struct Stencil {
 
   // Returns false when a node of the support lies outside the (ghost-padded) grid.
   template <bool Offsets = false>
-  bool compute(const Grid<Dim>& g, const Vec<Dim>& x, double half_width) {
+  bool compute(const Lattice<Dim>& g, const Vec<Dim>& x, double half_width) {
     double w[Dim][support], dw[Dim][support], rel[Dim];
     std::array<int, Dim> base;
-    // A product, not a quotient: inlined into a particle loop, 1 / h is
-    // computed once for all particles.
-    const double inv_h = 1.0 / g.h;
+    const double inv_h = g.inv_h;
     for (int d = 0; d < Dim; ++d) {
       const double xi = (x[d] - g.lower[d]) * inv_h + Grid<Dim>::ghost;
       base[d] = Shape::eval(xi, half_width, w[d], dw[d]);
       rel[d] = (base[d] - xi) * g.h;
-      if (base[d] < 0 || base[d] + support > g.nodes_along(d)) return false;
+      if (base[d] < 0 || base[d] + support > g.nodes_along[d]) return false;
     }
     int k = 0;
     if constexpr (Dim == 2) {
-      const std::size_t first = g.index({base[0], base[1]}), row = static_cast<std::size_t>(g.nodes_along(0));
+      const std::size_t first = g.index({base[0], base[1]}), row = static_cast<std::size_t>(g.nodes_along[0]);
       for (int j = 0; j < support; ++j)
         for (int i = 0; i < support; ++i, ++k) {
           node[k] = first + j * row + i;

@@ -18,16 +18,16 @@ double DruckerPrager::yield(const Mat<2>& s, double s_zz) const {
 }
 
 double DruckerPrager::return_map(Mat<2>& s, double& s_zz, double* work_density) const {
-  const double g = elasticity().shear_modulus();
-  return drucker_prager_return(alpha_, k_, alpha_dilation_, g, elasticity().lame_lambda() + 2.0 / 3.0 * g, s, s_zz,
-                               work_density);
+  const double g = shear_modulus();
+  return drucker_prager_return(alpha_, k_, alpha_dilation_, g, lame_lambda() + 2.0 / 3.0 * g, s, s_zz, work_density);
 }
 
 Dissipation DruckerPrager::update_chunk(Particles<2>& p, std::span<const int> members, double dt) const {
   // Equivalent plastic strain per unit multiplier: sqrt(2/3 |dg/dsigma|^2).
   const double strain_per_multiplier = std::sqrt(2.0 / 3.0 * (0.5 + alpha_dilation_ * alpha_dilation_ / 3));
+  const double lambda = lame_lambda(), shear = shear_modulus();
   return each_member(p, members, dt, [&](int i) {
-    elastic_trial(elasticity(), p.velocity_gradient[i], dt, p.stress[i], p.stress_zz[i]);
+    elastic_trial(lambda, shear, p.velocity_gradient[i], dt, p.stress[i], p.stress_zz[i]);
     double work = 0;
     const double multiplier = return_map(p.stress[i], p.stress_zz[i], &work);
     if (multiplier == 0) return Dissipation{};

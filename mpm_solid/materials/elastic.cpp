@@ -3,8 +3,9 @@
 namespace outburst::mpm {
 
 Dissipation LinearElastic::update_chunk(Particles<2>& p, std::span<const int> members, double dt) const {
+  const double lambda = lame_lambda(), shear = shear_modulus();
   return each_member(p, members, dt, [&](int i) {
-    elastic_trial(elasticity(), p.velocity_gradient[i], dt, p.stress[i], p.stress_zz[i]);
+    elastic_trial(lambda, shear, p.velocity_gradient[i], dt, p.stress[i], p.stress_zz[i]);
     return Dissipation{};
   });
 }

@@ -197,17 +197,17 @@ double ElasticDamage::modulus_scale(const Particles<2>& p, int i) const {
 }
 
 void ElasticDamage::trial(Particles<2>& p, int i, double dt) const {
-  Elasticity own = elasticity();
-  own.youngs_modulus *= modulus_scale(p, i);  // lambda and G scale with E
-  elastic_trial(own, p.velocity_gradient[i], dt, p.effective_stress[i], p.effective_stress_zz[i]);
+  const double stiffness = modulus_scale(p, i);  // lambda and G scale with E
+  elastic_trial(stiffness * lame_lambda(), stiffness * shear_modulus(), p.velocity_gradient[i], dt,
+                p.effective_stress[i], p.effective_stress_zz[i]);
 }
 
 // The acting stress at damage d, what the growth of damage took, and the
 // friction of compressive states.
 Dissipation ElasticDamage::settle(Particles<2>& p, int i, double d) const {
   const double stiffness = modulus_scale(p, i);
-  const double g = stiffness * elasticity().shear_modulus();
-  const double bulk = stiffness * elasticity().lame_lambda() + 2.0 / 3.0 * g;
+  const double g = stiffness * shear_modulus();
+  const double bulk = stiffness * lame_lambda() + 2.0 / 3.0 * g;
   Dissipation dissipated;
   Mat<2>& effective = p.effective_stress[i];
   double& effective_zz = p.effective_stress_zz[i];
