@@ -5,19 +5,23 @@
 // Problem: a square elastic (or plastic) block with 4 particles per cell
 // released under gravity onto a fixed floor, so that every step does real
 // work (moving particles, changing stresses).
-// Usage: mpm-benchmark [--csv FILE] [particles ...]   (default 1e4 1e5 1e6)
-//        mpm-benchmark --unloaded [particles]   (default 1e5)
+// Usage: mpm-benchmark [particles ...] [--csv FILE] [--shape S ...] [--material M ...] [--threads T ...]
+//        mpm-benchmark --unloaded [particles]   (--help says more)
 // --unloaded: one line, the throughput of an elastic block spinning free of
-// gravity and loads (B-splines, 1 thread, best of 5): what
-// scripts/unnamed-effects-benchmark.sh compares between the full build and
-// one without gravity, loads and pore pressure (OUTBURST_MPM_LEAN).
+// gravity and loads: what scripts/unnamed-effects-benchmark.sh compares between
+// the full build and one without gravity, loads and pore pressure
+// (OUTBURST_MPM_LEAN).
 #include <omp.h>
 
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <map>
 #include <string>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
 
 #include "mpm_solid/materials/drucker_prager.hpp"
 #include "mpm_solid/materials/elastic.hpp"
@@ -33,6 +37,9 @@ namespace {
 enum class Model { elastic, drucker_prager, elastic_damage };
 const char* model_name(Model m) {
   return m == Model::elastic ? "elastic" : m == Model::drucker_prager ? "drucker_prager" : "elastic_damage";
+}
+const char* shape_name(ShapeKind s) {
+  return s == ShapeKind::linear ? "linear" : s == ShapeKind::gimp ? "gimp" : "bspline";
 }
 
 double unloaded_particle_steps_per_second(long particles) {
@@ -124,62 +131,86 @@ Measured measure(long particles, ShapeKind shape, Model model, int threads) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc >= 2 && std::string(argv[1]) == "--unloaded") {
-    const double n = argc >= 3 ? std::strtod(argv[2], nullptr) : 1e5;
-    if (!(n >= 100)) {
-      std::fprintf(stderr, "usage: mpm-benchmark --unloaded [particles]   (at least 100)\n");
-      return 2;
-    }
-    std::printf("%.6e\n", unloaded_particle_steps_per_second(std::lround(n)));
+  CLI::App app("Particle-steps per second of the explicit MPM step (2D plane strain, 4 particles per cell), and "
+               "the memory per particle",
+               "mpm-benchmark");
+  std::vector<double> sizes{1e4, 1e5, 1e6};
+  std::string csv_path;
+  std::vector<int> thread_counts{1, 2};
+  bool unloaded = false;
+  app.add_option("particles", sizes, "particles of each row's block (at least 100; 1e5 is read)")
+      ->check(CLI::Range(100.0, 1e9))
+      ->capture_default_str();
+  app.add_option("--csv", csv_path, "also write the rows to this CSV file (README.md's table is written from "
+                                    "mpm_solid/benchmark/mpm-benchmark.csv)");
+  const std::map<std::string, ShapeKind> shape_words{
+      {"linear", ShapeKind::linear}, {"gimp", ShapeKind::gimp}, {"bspline", ShapeKind::bspline}};
+  const std::map<std::string, Model> model_words{
+      {"elastic", Model::elastic}, {"drucker_prager", Model::drucker_prager}, {"elastic_damage", Model::elastic_damage}};
+  std::vector<std::string> shape_names{"linear", "bspline"}, model_names{"elastic", "drucker_prager", "elastic_damage"};
+  app.add_option("--shape", shape_names, "the shape functions measured")
+      ->check(CLI::IsMember(shape_words))
+      ->capture_default_str();
+  app.add_option("--material", model_names, "the materials measured")
+      ->check(CLI::IsMember(model_words))
+      ->capture_default_str();
+  app.add_option("--threads", thread_counts, "thread counts measured; the speed-up column is the last over the first")
+      ->check(CLI::Range(1, 256));
+  app.add_flag("--unloaded", unloaded,
+               "one number: an elastic block spinning free of gravity and loads (B-splines, 1 thread, best of 5; "
+               "scripts/unnamed-effects-benchmark.sh), of the first particle count (default 1e5)");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // --help is a success; anything else is a bad command line (exit code 2, as every program here).
+    return app.exit(e) == 0 ? 0 : 2;
+  }
+  std::vector<ShapeKind> shapes;
+  std::vector<Model> models;
+  for (const auto& name : shape_names) shapes.push_back(shape_words.at(name));
+  for (const auto& name : model_names) models.push_back(model_words.at(name));
+  if (unloaded) {
+    const bool given = app.count("particles") > 0;
+    std::printf("%.6e\n", unloaded_particle_steps_per_second(given ? std::lround(sizes.front()) : 100000));
     return 0;
   }
-  std::vector<long> sizes;
-  std::FILE* csv = nullptr;  // --csv FILE: the table also as CSV (README.md's table is written from it)
-  for (int i = 1; i < argc; ++i) {
-    if (std::string(argv[i]) == "--csv" && i + 1 < argc) {
-      csv = std::fopen(argv[++i], "w");
-      if (!csv) {
-        std::fprintf(stderr, "mpm-benchmark: cannot write %s\n", argv[i]);
-        return 2;
-      }
-      std::fprintf(csv, "particles,shape,material,one_thread,two_threads,speed_up,bytes_per_particle,"
-                        "grid_bytes_per_particle\n");
-      continue;
-    }
-    char* end = nullptr;
-    const double n = std::strtod(argv[i], &end);
-    if (*end != '\0' || n < 100) {
-      std::fprintf(stderr, "usage: mpm-benchmark [--csv FILE] [particles ...]   (numbers of at least 100; default 1e4 "
-                           "1e5 1e6)\n");
+  std::FILE* csv = nullptr;
+  if (!csv_path.empty()) {
+    csv = std::fopen(csv_path.c_str(), "w");
+    if (!csv) {
+      std::fprintf(stderr, "mpm-benchmark: cannot write %s\n", csv_path.c_str());
       return 2;
     }
-    sizes.push_back(std::lround(n));
+    std::fprintf(csv, "particles,shape,material,one_thread,two_threads,speed_up,bytes_per_particle,"
+                      "grid_bytes_per_particle\n");
   }
-  if (sizes.empty()) sizes = {10000, 100000, 1000000};
   const int cores = omp_get_max_threads();
   std::printf("particle-steps per second (2D plane strain, 4 particles per cell), %d cores\n\n", cores);
   // Memory per particle: the particles' own fields and per-step arrays, and
-  // the grid's nodal arrays (with 2 threads' buffers) shared out over them.
-  std::printf("%9s %-9s %-15s %12s %12s %9s %14s %14s\n", "particles", "shape", "material", "1 thread", "2 threads",
-              "speed-up", "B/particle", "grid B/part.");
-  for (long n : sizes)
-    for (ShapeKind shape : {ShapeKind::linear, ShapeKind::bspline})
-      for (Model model : {Model::elastic, Model::drucker_prager, Model::elastic_damage}) {
-        const Measured one = measure(n, shape, model, 1);
-        const Measured two = measure(n, shape, model, std::min(2, cores));
-        const double count = static_cast<double>(two.particles);
-        std::printf("%9ld %-9s %-15s %12.3e %12.3e %9.2f %14.0f %14.0f\n", n,
-                    shape == ShapeKind::linear ? "linear" : "bspline", model_name(model),
-                    one.particle_steps_per_second, two.particle_steps_per_second,
-                    two.particle_steps_per_second / one.particle_steps_per_second,
-                    static_cast<double>(two.memory.particles) / count, static_cast<double>(two.memory.grid) / count);
+  // the grid's nodal arrays (with the last thread count's buffers) shared out over them.
+  std::printf("%9s %-9s %-15s", "particles", "shape", "material");
+  for (int t : thread_counts) std::printf(" %12s", fmt::format("{} thread{}", t, t == 1 ? "" : "s").c_str());
+  std::printf(" %9s %14s %14s\n", "speed-up", "B/particle", "grid B/part.");
+  for (double size : sizes)
+    for (ShapeKind shape : shapes)
+      for (Model model : models) {
+        const long n = std::lround(size);
+        std::vector<Measured> rows;
+        for (int t : thread_counts) rows.push_back(measure(n, shape, model, t));
+        const Measured& last = rows.back();
+        const double count = static_cast<double>(last.particles);
+        const double speed_up = last.particle_steps_per_second / rows.front().particle_steps_per_second;
+        std::printf("%9ld %-9s %-15s", n, shape_name(shape), model_name(model));
+        for (const auto& r : rows) std::printf(" %12.3e", r.particle_steps_per_second);
+        std::printf(" %9.2f %14.0f %14.0f\n", speed_up, static_cast<double>(last.memory.particles) / count,
+                    static_cast<double>(last.memory.grid) / count);
         std::fflush(stdout);
+        // The CSV keeps its two columns (one and two threads) for the README's table.
         if (csv)
-          std::fprintf(csv, "%ld,%s,%s,%.4e,%.4e,%.3f,%.0f,%.0f\n", n,
-                       shape == ShapeKind::linear ? "linear" : "bspline", model_name(model),
-                       one.particle_steps_per_second, two.particle_steps_per_second,
-                       two.particle_steps_per_second / one.particle_steps_per_second,
-                       static_cast<double>(two.memory.particles) / count, static_cast<double>(two.memory.grid) / count);
+          std::fprintf(csv, "%ld,%s,%s,%.4e,%.4e,%.3f,%.0f,%.0f\n", n, shape_name(shape), model_name(model),
+                       rows.front().particle_steps_per_second, last.particle_steps_per_second, speed_up,
+                       static_cast<double>(last.memory.particles) / count,
+                       static_cast<double>(last.memory.grid) / count);
       }
   if (csv && std::fclose(csv) != 0) {
     std::fprintf(stderr, "mpm-benchmark: the CSV could not be written in full\n");
