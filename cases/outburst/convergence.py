@@ -6,7 +6,7 @@ outburst-prone coal.
 usage: python3 -m cases.outburst.convergence [--outburst build/coupler/outburst] [--out results/outburst_convergence]
                                               [--cells 1/2 1/3 1/4 1/6 1/8] [--laws local crack_band]
                                               [--end-time "1 s"] [--at 0.5 1] [--resume | --measure-only]
-                                              [--seeds N [--homogeneity 3] [--jobs J]]
+                                              [--seeds N [--homogeneity 3] [--jobs J]] [--set KEY=VALUE ...]
 writes OUT/convergence.csv (a row per law, cell and time measured at),
 OUT/convergence.md (the headline numbers and the change between the two finest
 cells) and OUT/convergence.png; one run at a time, each on every core (the
@@ -198,6 +198,9 @@ def main():
                     help="side [m] of the squares of coal that share a draw (heterogeneity.grain_size), as a "
                          "fraction; without it each particle draws its own, and each cell another coal")
     ap.add_argument("--jobs", type=int, default=1, help="an ensemble's runs side by side (cores / jobs threads each)")
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                    help="a scene override (as the programs' --set) for every run, after the study's own: "
+                         "mpm.courant=0.19 runs each cell at another step; give such a study its own --out")
     ap.add_argument("--resume", action="store_true", help="keep the runs an earlier study finished")
     ap.add_argument("--measure-only", action="store_true",
                     help="run nothing: measure the runs an earlier study finished, and list the others as not run")
@@ -219,7 +222,7 @@ def main():
             label = f"{cell} m"
             name = f"{law}_{cell.numerator}_{cell.denominator}"
             overrides = [f'scene.end_time="{args.end_time}"', f'mpm.grid.cell_size="{float(cell)!r} m"',
-                         f'seepage.mesh.file="{seam_mesh(args.out, cell, f"seam_{cell.numerator}_{cell.denominator}.msh")}"', 'output.interval="0.1 s"']
+                         f'seepage.mesh.file="{seam_mesh(args.out, cell, f"seam_{cell.numerator}_{cell.denominator}.msh")}"', 'output.interval="0.1 s"'] + args.set
             row = {"law": law, "cell": label}
             if not args.seeds:
                 run_dir = os.path.join(args.out, name)
