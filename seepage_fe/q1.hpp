@@ -71,16 +71,17 @@ template <class Nodal>
 Sample sample_affine(const std::array<int, 4>& nodes, const Nodal& u, const Eigen::Vector2d& reference,
                      const Eigen::Matrix2d& inverse_jacobian) {
   const double xi = reference.x(), eta = reference.y();
-  Sample s{0.0, Eigen::Vector2d::Zero()};
-  Eigen::Vector2d along_reference = Eigen::Vector2d::Zero();  // d u / d(xi, eta)
+  // Scalars throughout: a 2-vector assembled from scalar stores and read
+  // back whole stalls the load (no store forwarding) on every sample.
+  double value = 0, along_xi = 0, along_eta = 0;  // u and d u / d(xi, eta)
   for (int a = 0; a < 4; ++a) {
     const double ua = u[nodes[a]];
-    s.value += 0.25 * (1 + corner_xi[a] * xi) * (1 + corner_eta[a] * eta) * ua;
-    along_reference += Eigen::Vector2d(0.25 * corner_xi[a] * (1 + corner_eta[a] * eta),
-                                       0.25 * corner_eta[a] * (1 + corner_xi[a] * xi)) * ua;
+    value += 0.25 * (1 + corner_xi[a] * xi) * (1 + corner_eta[a] * eta) * ua;
+    along_xi += 0.25 * corner_xi[a] * (1 + corner_eta[a] * eta) * ua;
+    along_eta += 0.25 * corner_eta[a] * (1 + corner_xi[a] * xi) * ua;
   }
-  s.gradient = inverse_jacobian.transpose() * along_reference;
-  return s;
+  const Eigen::Matrix2d& g = inverse_jacobian;  // grad u = g^T d u / d(xi, eta)
+  return {value, Eigen::Vector2d(g(0, 0) * along_xi + g(1, 0) * along_eta, g(0, 1) * along_xi + g(1, 1) * along_eta)};
 }
 
 // 2x2 Gauss rule, exact for the bilinear stiffness on parallelograms.
