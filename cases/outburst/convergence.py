@@ -198,6 +198,10 @@ def main():
                     help="side [m] of the squares of coal that share a draw (heterogeneity.grain_size), as a "
                          "fraction; without it each particle draws its own, and each cell another coal")
     ap.add_argument("--jobs", type=int, default=1, help="an ensemble's runs side by side (cores / jobs threads each)")
+    ap.add_argument("--threads", type=int,
+                    help="threads of each run (default: every core, shared out over an ensemble's jobs); two "
+                         "studies of one cell each at --threads 1 run side by side without their threads "
+                         "waiting on each other")
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                     help="a scene override (as the programs' --set) for every run, after the study's own: "
                          "mpm.courant=0.19 runs each cell at another step; give such a study its own --out")
@@ -205,15 +209,15 @@ def main():
     ap.add_argument("--measure-only", action="store_true",
                     help="run nothing: measure the runs an earlier study finished, and list the others as not run")
     args = ap.parse_args()
-    if args.seeds < 0 or args.homogeneity < 1 or args.jobs < 1:
-        ap.error("--seeds must be at least 0, --homogeneity and --jobs at least 1")
+    if args.seeds < 0 or args.homogeneity < 1 or args.jobs < 1 or (args.threads is not None and args.threads < 1):
+        ap.error("--seeds must be at least 0, --homogeneity, --jobs and --threads at least 1")
     if args.grain_size is not None and (args.grain_size <= 0 or not args.seeds):
         ap.error("--grain-size must be positive, and needs --seeds")
     os.makedirs(args.out, exist_ok=True)
     cells = [Fraction(c) for c in args.cells]
     cores = os.cpu_count() or 1
     jobs = min(args.jobs, cores, max(args.seeds, 1))
-    threads = max(1, cores // jobs)
+    threads = args.threads or max(1, cores // jobs)
     grain = "" if args.grain_size is None else f"_g{args.grain_size.numerator}_{args.grain_size.denominator}"
     rows = []
     for law in args.laws:
@@ -226,7 +230,7 @@ def main():
             row = {"law": law, "cell": label}
             if not args.seeds:
                 run_dir = os.path.join(args.out, name)
-                rows += measured(kept_or_run(args, law, scene, overrides, run_dir, label, cores), run_dir, row,
+                rows += measured(kept_or_run(args, law, scene, overrides, run_dir, label, args.threads or cores), run_dir, row,
                                  args.at)
                 print(f"{law}, {label}: {rows[-1]}", flush=True)
                 continue
