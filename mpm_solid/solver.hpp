@@ -13,6 +13,7 @@
 // solver picks one specialised kernel at construction, so neither costs a
 // branch per particle.
 
+#include <algorithm>
 #include <array>
 #include <functional>
 #include <memory>
@@ -182,14 +183,18 @@ struct StepInfo {
 
 // What the last pass over the particles in a step found: the work of the
 // external forces over the step and the particles that went wrong or left.
+// The same pass finds the fastest signal, max (c_p + |v_p|), over the
+// particles that stay: the next stable step, without a pass of its own.
 struct Census {
   double external_work = 0;
   long bad = 0, escaped = 0, runaway = 0;
+  double fastest = 0;
   Census& operator+=(const Census& o) {
     external_work += o.external_work;
     bad += o.bad;
     escaped += o.escaped;
     runaway += o.runaway;
+    fastest = std::max(fastest, o.fastest);
     return *this;
   }
 };
@@ -208,7 +213,8 @@ class Solver {
   Solver(Grid<2> grid, std::vector<std::unique_ptr<Material>> materials, Particles<2> particles,
          Settings settings);
 
-  // The free function's step for this solver's particles and grid.
+  // The free function's step for this solver's particles and grid (as the
+  // last step's move found it, or computed afresh).
   double stable_time_step() const;
   // One explicit step; SimulationError (naming the step, particle and field)
   // if a particle's state becomes non-finite or it outruns its P wave.
@@ -323,6 +329,10 @@ class Solver {
 
   std::vector<std::vector<int>> members_;  // particle indices per material
   std::vector<double> wave_speed_squared_;  // per material, for the runaway check
+  std::vector<double> p_modulus_;           // lambda + 2 G per material, for the stable step
+  // max (c_p + |v_p|) over the particles now, as the last move counted it; 0
+  // when the particles changed since (restored, loaded, set at rest).
+  double fastest_ = 0;
   // Square of the speed beyond which particle i is running away.
   double runaway_speed_squared(int i) const;
   double empty_node_mass_ = 0;
