@@ -19,35 +19,58 @@ namespace {
 template <class Shape>
 using Stencil2 = Stencil<2, Shape>;
 
+using Runs = std::vector<ActiveBlocks::Run>;
+
+// Runs f(i) over the nodes of the runs, in parallel.
+template <class F>
+void over_nodes(const Runs& runs, F&& f) {
+  const int n = static_cast<int>(runs.size());
+#pragma omp parallel for schedule(static)
+  for (int r = 0; r < n; ++r)
+    for (std::size_t i = runs[r].first, end = i + static_cast<std::size_t>(runs[r].count); i < end; ++i) f(i);
+}
+
+// The sum of f(i) over the nodes of the runs, in parallel.
+template <class F>
+double sum_over_nodes(const Runs& runs, F&& f) {
+  const int n = static_cast<int>(runs.size());
+  double sum = 0;
+#pragma omp parallel for schedule(static) reduction(+ : sum)
+  for (int r = 0; r < n; ++r)
+    for (std::size_t i = runs[r].first, end = i + static_cast<std::size_t>(runs[r].count); i < end; ++i) sum += f(i);
+  return sum;
+}
+
+template <class T>
+T zero() {
+  if constexpr (std::is_arithmetic_v<T>)
+    return T(0);
+  else
+    return T::Zero();
+}
+
 // Scattering without locks: thread 0 adds straight into the grid field, the
-// others into private copies that gather() adds in afterwards. The field is
-// cleared first; buffer(t) is where thread t writes.
+// others into private copies that gather() adds in afterwards, over the
+// active nodes (nothing is scattered elsewhere). buffer(t) is where thread t
+// writes.
 template <class T>
 struct Scatter {
   std::vector<std::vector<T>>& others;  // threads 1, 2, ...
   std::vector<T>& total;
+  const Runs& runs;
 
-  static T zero() {
-    if constexpr (std::is_arithmetic_v<T>)
-      return T(0);
-    else
-      return T::Zero();
-  }
   void clear() {
-    const std::size_t n = total.size();
-#pragma omp parallel for schedule(static)
-    for (std::size_t i = 0; i < n; ++i) total[i] = zero();
+    over_nodes(runs, [&](std::size_t i) { total[i] = zero<T>(); });
   }
   std::vector<T>& buffer(int t) { return t == 0 ? total : others[static_cast<std::size_t>(t - 1)]; }
   void gather() {
     if (others.empty()) return;
-    const std::size_t n = total.size();
-#pragma omp parallel for schedule(static)
-    for (std::size_t i = 0; i < n; ++i)
+    over_nodes(runs, [&](std::size_t i) {
       for (auto& part : others) {
         total[i] += part[i];
-        part[i] = zero();
+        part[i] = zero<T>();
       }
+    });
   }
 };
 
@@ -161,7 +184,16 @@ Solver::Solver(Grid<2> grid, std::vector<std::unique_ptr<Material>> materials,
     : grid_(grid),
       materials_(std::move(materials)),
       particles_(std::move(particles)),
-      settings_(settings) {
+      settings_(settings),
+      active_(grid_,
+              [&] {
+                std::array<bool, 4> mirrored{};
+                for (int side = 0; side < 4; ++side)
+                  mirrored[side] = settings.walls[side].type == Wall::Type::fixed ||
+                                   settings.walls[side].type == Wall::Type::roller;
+                return mirrored;
+              }(),
+              omp_get_max_threads()) {
   if (particles_.size() == 0) throw std::invalid_argument("the scene creates no particles");
   const std::size_t n = grid_.num_nodes();
   mass_.assign(n, 0.0);
@@ -280,19 +312,21 @@ template <class Shape, bool Apic>
 void Solver::scatter_mass_momentum() {
   const auto& p = particles_;
   const int n = static_cast<int>(p.size());
-  Scatter<double> masses{thread_mass_, mass_};
-  Scatter<Vec<2>> momenta{thread_vector_, momentum_};
-  masses.clear();
-  momenta.clear();
+  clear_grid();
+  Scatter<double> masses{thread_mass_, mass_, active_.runs()};
+  Scatter<Vec<2>> momenta{thread_vector_, momentum_, active_.runs()};
 #pragma omp parallel num_threads(threads_)
   {
     double* m = masses.buffer(omp_get_thread_num()).data();
     Vec<2>* mv = momenta.buffer(omp_get_thread_num()).data();
+    std::uint8_t* reached = active_.marks(omp_get_thread_num());
+    const int blocks_along_x = active_.blocks_along_x();
     const Lattice<2> lattice(grid_);
     Stencil2<Shape> s;
 #pragma omp for schedule(static)
     for (int i = 0; i < n; ++i) {
       s.template compute<Apic>(lattice, p.x[i], p.half_width[i]);
+      ActiveBlocks::set_reached<Shape::support>(reached, blocks_along_x, s.base);
       // Read once: the compiler cannot tell the nodal sums from the
       // particle's fields, and would load these again after every store.
       const double mass = p.mass[i];
@@ -307,16 +341,23 @@ void Solver::scatter_mass_momentum() {
       }
     }
   }
+  active_.collect();
   masses.gather();
   momenta.gather();
   fold_ghosts(&mass_, momentum_);
 }
 
+void Solver::clear_grid() {
+  over_nodes(active_.runs(), [&](std::size_t i) {
+    mass_[i] = 0;
+    momentum_[i] = force_[i] = velocity_[i] = velocity_new_[i] = Vec<2>::Zero();
+  });
+}
+
 void Solver::grid_velocities() {
-  const std::size_t n = mass_.size();
-#pragma omp parallel for schedule(static)
-  for (std::size_t i = 0; i < n; ++i)
+  over_nodes(active_.runs(), [&](std::size_t i) {
     velocity_[i] = mass_[i] > empty_node_mass_ ? Vec<2>(momentum_[i] / mass_[i]) : Vec<2>::Zero();
+  });
   apply_platens(velocity_, 0, 0);
   apply_walls(velocity_);
 }
@@ -366,7 +407,7 @@ void Solver::smooth_dilatation() {
   const int n = static_cast<int>(p.size());
   // Scatter V tr(L) and V into force_, which is free until scatter_forces
   // rebuilds it.
-  Scatter<Vec<2>> sums{thread_vector_, force_};
+  Scatter<Vec<2>> sums{thread_vector_, force_, active_.runs()};
   sums.clear();
 #pragma omp parallel num_threads(threads_)
   {
@@ -412,7 +453,7 @@ void Solver::scatter_forces() {
   const auto& p = particles_;
   const int n = static_cast<int>(p.size());
   const ForceTerms terms = force_terms(p, settings_);
-  Scatter<Vec<2>> forces{thread_vector_, force_};
+  Scatter<Vec<2>> forces{thread_vector_, force_, active_.runs()};
   forces.clear();
 #pragma omp parallel num_threads(threads_)
   {
@@ -440,7 +481,7 @@ template <class Shape>
 void Solver::update_and_scatter(double dt) {
   auto& p = particles_;
   const ForceTerms terms = force_terms(p, settings_);
-  Scatter<Vec<2>> forces{thread_vector_, force_};
+  Scatter<Vec<2>> forces{thread_vector_, force_, active_.runs()};
   forces.clear();
   double plastic = 0, damage = 0;
 #pragma omp parallel num_threads(threads_) reduction(+ : plastic, damage)
@@ -474,11 +515,10 @@ void Solver::update_and_scatter(double dt) {
 }
 
 void Solver::grid_update(double dt) {
-  const std::size_t n = mass_.size();
+  const Runs& runs = active_.runs();
   if (const double alpha = settings_.local_damping; alpha > 0) {
-    double work = 0;
-#pragma omp parallel for schedule(static) reduction(+ : work)
-    for (std::size_t i = 0; i < n; ++i)
+    dissipated_.damping += sum_over_nodes(runs, [&](std::size_t i) {
+      double work = 0;
       for (int d = 0; d < 2; ++d)
         if (velocity_[i][d] != 0) {
           const double damping = alpha * std::abs(force_[i][d]);
@@ -487,14 +527,15 @@ void Solver::grid_update(double dt) {
           // work is that node's, booked once.
           if (counted_[i]) work += damping * std::abs(velocity_[i][d]) * dt;
         }
-    dissipated_.damping += work;
+      return work;
+    });
   }
   // v_new = (v + dt f / m) / (1 + c dt): the viscous force -c m v_new.
   const double c = settings_.viscous_damping, shrink = 1 / (1 + c * dt);
-#pragma omp parallel for schedule(static)
-  for (std::size_t i = 0; i < n; ++i)
+  over_nodes(runs, [&](std::size_t i) {
     velocity_new_[i] =
         mass_[i] > empty_node_mass_ ? Vec<2>(shrink * (velocity_[i] + dt * force_[i] / mass_[i])) : Vec<2>::Zero();
+  });
   apply_platens(velocity_new_, shrink * dt, dt);  // before the walls: the ghost nodes mirror the plate's motion
   dissipated_.walls += apply_walls(velocity_new_);
   // The grid's work on pure FLIP particles is sum_i p_i . dv_i here, with
@@ -502,24 +543,24 @@ void Solver::grid_update(double dt) {
   // gather_motion (Solver::energies). Walls and platens changed p_i to
   // m_i v_i before the update: that change, worked by the update, is theirs.
   double work = 0, projected = 0;
+  const int nr = static_cast<int>(runs.size());
 #pragma omp parallel for schedule(static) reduction(+ : work, projected)
-  for (std::size_t i = 0; i < n; ++i)
-    if (counted_[i]) {
-      const Vec<2> change = velocity_new_[i] - velocity_[i];
-      work += mass_[i] * velocity_[i].dot(change);
-      projected += (momentum_[i] - mass_[i] * velocity_[i]).dot(change);
-    }
+  for (int r = 0; r < nr; ++r)
+    for (std::size_t i = runs[r].first, end = i + static_cast<std::size_t>(runs[r].count); i < end; ++i)
+      if (counted_[i]) {
+        const Vec<2> change = velocity_new_[i] - velocity_[i];
+        work += mass_[i] * velocity_[i].dot(change);
+        projected += (momentum_[i] - mass_[i] * velocity_[i]).dot(change);
+      }
   dissipated_.grid_work += work + projected;
   dissipated_.walls -= projected;
   if (c > 0) {
     // The damping force -c m v_new works along the way the nodes carry the
     // particles, v_new dt (after the walls: what a wall stops does not move),
     // as the external forces are booked.
-    double viscous_work = 0;
-#pragma omp parallel for schedule(static) reduction(+ : viscous_work)
-    for (std::size_t i = 0; i < n; ++i)
-      if (counted_[i]) viscous_work += c * dt * mass_[i] * velocity_new_[i].squaredNorm();
-    dissipated_.damping += viscous_work;
+    dissipated_.damping += sum_over_nodes(runs, [&](std::size_t i) {
+      return counted_[i] ? c * dt * mass_[i] * velocity_new_[i].squaredNorm() : 0.0;
+    });
   }
 }
 
@@ -936,7 +977,7 @@ Solver::Memory Solver::memory() const {
   m.particles += bytes(displacement_);
   for (const auto& group : members_) m.particles += bytes(group);
   for (const auto* v : {&momentum_, &force_, &velocity_, &velocity_new_}) m.grid += bytes(*v);
-  m.grid += bytes(mass_) + bytes(node_ij_) + bytes(counted_);
+  m.grid += bytes(mass_) + bytes(node_ij_) + bytes(counted_) + active_.bytes();
   for (const auto& t : thread_mass_) m.grid += bytes(t);
   for (const auto& t : thread_vector_) m.grid += bytes(t);
   return m;

@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "mpm_solid/active_blocks.hpp"
 #include "mpm_solid/grid.hpp"
 #include "mpm_solid/material.hpp"
 #include "mpm_solid/particles.hpp"
@@ -276,6 +277,9 @@ class Solver {
   // at a set speed.
   const std::vector<double>& platen_force() const { return platen_force_; }
 
+  // The grid nodes the last step's passes ran over (ActiveBlocks).
+  std::size_t active_nodes() const { return active_.active_nodes(); }
+
   // Memory held now [bytes]: by the particles (every field, and the per-step
   // arrays sized by them) and by the grid (the nodal arrays, one set per thread).
   struct Memory {
@@ -344,6 +348,8 @@ class Solver {
   std::vector<std::vector<double>> thread_mass_;     // of threads 1, 2, ...
   std::vector<std::vector<Vec<2>>> thread_vector_;
   std::vector<std::array<int, 2>> node_ij_;  // grid coordinates of each node
+  ActiveBlocks active_;  // where the nodal arrays may be nonzero
+  void clear_grid();     // zeroes them there, before a new mapping
   // Nodes whose mass counts once (in the damping's work): not the ghosts
   // beyond a fixed or roller wall, whose share fold_ghosts moved inside.
   std::vector<char> counted_;

@@ -38,12 +38,12 @@ struct Stencil {
   // and scalars written as scalars forward to their loads without a stall.
   std::array<std::array<double, count>, Dim> gradient;
   std::array<Vec<Dim>, count> offset;    // x_node - x_particle [m], only with Offsets
+  std::array<int, Dim> base;             // grid coordinates of the lowest node
 
   // Returns false when a node of the support lies outside the (ghost-padded) grid.
   template <bool Offsets = false>
   bool compute(const Lattice<Dim>& g, const Vec<Dim>& x, double half_width) {
     double w[Dim][support], dw[Dim][support], rel[Dim];
-    std::array<int, Dim> base;
     const double inv_h = g.inv_h;
     for (int d = 0; d < Dim; ++d) {
       const double xi = (x[d] - g.lower[d]) * inv_h + Grid<Dim>::ghost;
