@@ -444,6 +444,35 @@ def mpm_benchmark(rows):
     return lines
 
 
+def milliseconds(seconds):
+    ms = 1e3 * seconds
+    return f"{ms:.3g}" if ms < 1000 else f"{ms:.0f}"
+
+
+ORDERINGS = ["amd", "metis", "nesdis", "cholmod_default"]
+
+
+@block("seepage orderings", "seepage_fe/benchmark/orderings.csv")
+def seepage_orderings(rows):
+    """CHOLMOD's factor-and-solve per mode and ordering, the fastest in bold, and the solver's pick."""
+    lines = ["| unknowns | mesh | simplicial: " + " / ".join(ORDERINGS) + " [ms] | supernodal: " + " / ".join(ORDERINGS)
+             + " [ms] | the solver's | its time / the fastest |", "|---|---|---|---|---|---|"]
+    cases = {}
+    for r in rows:
+        cases.setdefault((int(r["unknowns"]), r["mesh"]), {})[(r["mode"], r["ordering"])] = r
+    for (n, mesh), by in sorted(cases.items(), key=lambda c: (c[0][1] != "square", c[0][0])):
+        def cell(mode):
+            if not any(m == mode for m, _ in by):
+                return "not run"
+            times = [float(by[(mode, o)]["factor_solve_s"]) for o in ORDERINGS]
+            return " / ".join(f"**{milliseconds(t)}**" if float(by[(mode, o)]["over_fastest"]) == 1 else milliseconds(t)
+                              for t, o in zip(times, ORDERINGS))
+        chosen = next(r for r in by.values() if r["chosen"] == "1")
+        lines.append(f"| {n} | {mesh} | {cell('simplicial')} | {cell('supernodal')} | "
+                     f"{chosen['mode']}/{chosen['ordering']} | {float(chosen['over_fastest']):.2f} |")
+    return lines
+
+
 @block("outburst convergence", "cases/outburst/convergence/convergence.csv")
 def outburst_convergence(rows):
     from .outburst.convergence import QUANTITIES, table

@@ -17,13 +17,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// CHOLMOD's simplicial factorisation is faster on small meshes and its
-// supernodal one (nested dissection, BLAS) on large ones; the switch sits
-// where their times cross on the benchmark's Jacobian
-// (seepage_fe/benchmark/crossover.csv: `seepage-benchmark --csv` writes the
-// simplicial / supernodal time per size).
-constexpr std::size_t supernodal_threshold = 10000;
-
 // Adds the wall time of its scope to a counter.
 class ScopedTimer {
  public:
@@ -36,6 +29,40 @@ class ScopedTimer {
 };
 
 }  // namespace
+
+// The fastest numeric factorisation by size, read from
+// seepage_fe/benchmark/orderings.csv (`seepage-benchmark --orderings-csv`, on
+// the unit square and the outburst's meshes; the README tables it). Below
+// about 5000 unknowns simplicial: its loops beat supernodal's BLAS calls, and
+// the orderings tie, so AMD, the quickest to compute. From there supernodal
+// with CHOLMOD's nested dissection: the fewest flops (to 1 %) and the fastest
+// or within 11 % of it (the noise) at every size to 1e6. Its analysis, the slowest
+// (seconds at 1e6), is done once per run.
+Factorisation factorisation_for(std::size_t unknowns) {
+  using F = Factorisation;
+  if (unknowns < 5000) return {F::Mode::simplicial, F::Ordering::amd};
+  return {F::Mode::supernodal, F::Ordering::nesdis};
+}
+
+std::string Factorisation::name() const {
+  static constexpr const char* orderings[] = {"amd", "metis", "nesdis", "cholmod_default"};
+  return fmt::format("{}/{}", mode == Mode::simplicial ? "simplicial" : "supernodal",
+                     orderings[static_cast<int>(ordering)]);
+}
+
+void configure(Cholmod& factor, Factorisation f) {
+  factor.setMode(f.mode == Factorisation::Mode::simplicial ? Eigen::CholmodSimplicialLLt
+                                                           : Eigen::CholmodSupernodalLLt);
+  cholmod_common& c = factor.cholmod();
+  if (f.ordering == Factorisation::Ordering::cholmod_default) {
+    c.nmethods = 0;
+    return;
+  }
+  c.nmethods = 1;
+  c.method[0].ordering = f.ordering == Factorisation::Ordering::amd     ? CHOLMOD_AMD
+                         : f.ordering == Factorisation::Ordering::metis ? CHOLMOD_METIS
+                                                                        : CHOLMOD_NESDIS;
+}
 
 double Balance::error() const {
   double inflow = inflow_through_flux;
@@ -136,17 +163,9 @@ void Solver::setup_system() {
 
   jacobian_ = stiffness_;
   assemble_conductivity();
-  // Supernodal CHOLMOD pays off on large systems only; below that its BLAS calls
-  // cost more than the work (simplicial is 3x faster at 1e4 unknowns). Large
-  // systems are ordered by nested dissection: a slower analysis, done once, for
-  // a factorisation repeated every Newton iteration.
   blas::set_threads_for(static_cast<long>(n));
-  const bool supernodal = this->supernodal();
-  factor_.setMode(supernodal ? Eigen::CholmodSupernodalLLt : Eigen::CholmodSimplicialLLt);
-  if (supernodal) {
-    factor_.cholmod().nmethods = 1;
-    factor_.cholmod().method[0].ordering = CHOLMOD_NESDIS;
-  }
+  factorisation_ = factorisation_for(n);
+  configure(factor_, factorisation_);
   factor_.analyzePattern(jacobian_);
   const std::size_t size = n;
   for (auto* v : {&trial_, &history_, &load_, &r_, &delta_, &candidate_})
@@ -483,8 +502,6 @@ StepReport Solver::advance(double dt) {
   }
   return report;
 }
-
-bool Solver::supernodal() const { return mesh_.num_nodes() >= supernodal_threshold; }
 
 std::optional<double> Solver::pressure_at(const Eigen::Vector2d& x) const {
   const auto s = sampler_.sample(u_, x);

@@ -58,6 +58,21 @@ struct Balance {
   double total_outflow() const;  // through pressure boundaries, > 0 when gas leaves
 };
 
+// How CHOLMOD factorises the Jacobian: its mode and fill-reducing ordering
+// ("cholmod_default": AMD, and METIS too when AMD fills in much).
+struct Factorisation {
+  enum class Mode { simplicial, supernodal };
+  enum class Ordering { amd, metis, nesdis, cholmod_default };
+  Mode mode;
+  Ordering ordering;
+  std::string name() const;  // "supernodal/nesdis"
+};
+// The one the solver picks for a Jacobian of this many unknowns.
+Factorisation factorisation_for(std::size_t unknowns);
+using Cholmod = Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::Lower>;
+// Sets the mode and ordering, before analyzePattern.
+void configure(Cholmod& factor, Factorisation f);
+
 // Wall time spent in each part of the solver [s], for benchmarks and studies.
 struct Timings {
   double assembly = 0;       // conductivity matrix
@@ -137,8 +152,8 @@ class Solver {
   const Balance& balance() const { return balance_; }
   const Timings& timings() const { return timings_; }
 
-  // Whether CHOLMOD runs supernodal (large systems) or simplicial.
-  bool supernodal() const;
+  // How CHOLMOD factorises.
+  const Factorisation& factorisation() const { return factorisation_; }
   // The current Jacobian (for benchmarks that time a bare factorisation of it).
   const Eigen::SparseMatrix<double>& jacobian() const { return jacobian_; }
 
@@ -180,7 +195,8 @@ class Solver {
   long conductivity_version_ = 0;
   Eigen::SparseMatrix<double> stiffness_;  // K = sum_e k_e K_e
   Eigen::SparseMatrix<double> jacobian_;
-  Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::Lower> factor_;
+  Factorisation factorisation_{};
+  Cholmod factor_;
   struct FactorKey {
     double h = -1, a0 = 0;
     long version = -1;
