@@ -473,6 +473,22 @@ def seepage_orderings(rows):
     return lines
 
 
+@block("seepage linear solvers", "seepage_fe/benchmark/crossover.csv")
+def seepage_linear_solvers(rows):
+    """Per Newton iteration: CHOLMOD against conjugate gradients, by size and time step."""
+    lines = ["| unknowns | mesh | time step | direct [s] | cg [s] | cg iterations per Newton iteration | cg / direct |",
+             "|---|---|---|---|---|---|---|"]
+    cases = {}
+    for r in rows:
+        cases.setdefault((r["mesh"], float(r["time_step_s"]), int(r["unknowns"])), {})[r["linear_solver"]] = r
+    for (mesh, dt, n), by in sorted(cases.items(), key=lambda c: (c[0][0] != "square", c[0][1], c[0][2])):
+        direct, cg = by["direct"], by["cg"]
+        lines.append(f"| {n} | {mesh} | {sci(dt, 0)} s | {float(direct['newton_iteration_s']):.3g} | "
+                     f"{float(cg['newton_iteration_s']):.3g} | {float(cg['cg_iterations']):.0f} | "
+                     f"{float(cg['over_reference']):.2f} |")
+    return lines
+
+
 @block("outburst convergence", "cases/outburst/convergence/convergence.csv")
 def outburst_convergence(rows):
     from .outburst.convergence import QUANTITIES, table

@@ -1,6 +1,6 @@
-// seepage-benchmark: the seepage solver's Newton iterations, and CHOLMOD's
-// factorisation of their Jacobian under each mode and ordering, measured in
-// one run.
+// seepage-benchmark: the seepage solver's Newton iterations under each linear
+// solver, and CHOLMOD's factorisation of their Jacobian under each mode and
+// ordering, measured in one run.
 //
 // Problem (as issue 2 fixed it): unit square, A = 2, lambda = 0.1, P0 = 9
 // (p0 = 3), the left side drained to p = 1, backward Euler, Newton, steps of
@@ -79,15 +79,18 @@ seepage::Timings minus(const seepage::Timings& a, const seepage::Timings& b) {
   d.solve = a.solve - b.solve;
   d.total_step = a.total_step - b.total_step;
   d.nonlinear_iterations = a.nonlinear_iterations - b.nonlinear_iterations;
+  d.linear_iterations = a.linear_iterations - b.linear_iterations;
   return d;
 }
 
-void newton_rows(const Case& c, const std::vector<std::string>& linear_solvers, double dt, int rounds,
-                 std::FILE* csv) {
+void newton_rows(const Case& c, const std::vector<std::string>& linear_solvers, double dt, double cg_tolerance,
+                 int rounds, std::FILE* csv) {
   std::vector<Contender> contenders;
   for (const auto& name : linear_solvers) {
     seepage::Settings settings;
     settings.scheme = seepage::TimeScheme::backward_euler;
+    settings.linear_solver = name == "cg" ? seepage::LinearSolver::cg : seepage::LinearSolver::direct;
+    settings.cg_tolerance = cg_tolerance;
     contenders.push_back({name, std::make_unique<seepage::Solver>(c.mesh, c.model, settings)});
     contenders.back().solver->advance(dt);  // first touch of every array
   }
@@ -107,17 +110,20 @@ void newton_rows(const Case& c, const std::vector<std::string>& linear_solvers, 
   for (const auto& k : contenders) {
     const auto& t = k.best;
     const double its = static_cast<double>(t.nonlinear_iterations);
-    const std::string method = k.solver->factorisation().name();
+    const std::string method =
+        k.linear_solver == "cg" ? "cg/incomplete_cholesky" : k.solver->factorisation().name();
     const long unknowns = static_cast<long>(c.mesh.num_nodes());
-    std::printf("%9ld %-14s %7.0e %-7s %-24s %7.0f %10.4f %9.4f %9.4f %9.4f %8.3f\n", unknowns,
+    const double cg_iterations = static_cast<double>(t.linear_iterations) / its;
+    std::printf("%9ld %-14s %7.0e %-7s %-24s %7.0f %10.4f %9.4f %9.4f %9.4f %8.1f %8.3f\n", unknowns,
                 c.mesh_name.c_str(), dt, k.linear_solver.c_str(), method.c_str(), its, k.best_per_iteration,
                 t.factorization / its, t.solve / its, (t.total_step - t.factorization - t.solve) / its,
-                k.best_per_iteration / direct);
+                cg_iterations, k.best_per_iteration / direct);
     std::fflush(stdout);
     if (csv)
-      std::fprintf(csv, "%ld,%s,%g,%s,%s,%.0f,%.6g,%.6g,%.6g,%.6g,%.4f\n", unknowns, c.mesh_name.c_str(), dt,
-                   k.linear_solver.c_str(), method.c_str(), its, k.best_per_iteration, t.factorization / its,
-                   t.solve / its, (t.total_step - t.factorization - t.solve) / its, k.best_per_iteration / direct);
+      std::fprintf(csv, "%ld,%s,%g,%s,%s,%g,%.0f,%.6g,%.6g,%.6g,%.6g,%.1f,%.4f\n", unknowns, c.mesh_name.c_str(),
+                   dt, k.linear_solver.c_str(), method.c_str(), k.linear_solver == "cg" ? cg_tolerance : 0.0, its,
+                   k.best_per_iteration, t.factorization / its, t.solve / its,
+                   (t.total_step - t.factorization - t.solve) / its, cg_iterations, k.best_per_iteration / direct);
   }
 }
 
@@ -193,9 +199,10 @@ int main(int argc, char** argv) {
                "their Jacobian under each mode and ordering",
                "seepage-benchmark");
   std::vector<int> sides{99, 315, 999};
-  std::vector<std::string> meshes, linear_solvers{"direct"};
+  std::vector<std::string> meshes, linear_solvers{"direct", "cg"};
   std::string csv_path, orderings_path;
   std::vector<double> time_steps{1e-3};
+  double cg_tolerance = seepage::Settings{}.cg_tolerance;
   int rounds = 3;
   long simplicial_up_to = std::numeric_limits<long>::max();
   bool no_newton = false, no_orderings = false;
@@ -209,11 +216,14 @@ int main(int argc, char** argv) {
                  "write the factorisations' rows to this CSV (seepage_fe/benchmark/orderings.csv is one, from which "
                  "the solver's choice of mode and ordering is set)");
   app.add_option("--linear-solvers", linear_solvers, "linear solvers of the Newton rows, the first the reference")
-      ->check(CLI::IsMember({"direct"}))
+      ->check(CLI::IsMember({"direct", "cg"}))
       ->capture_default_str();
   app.add_option("--time-step", time_steps, "time steps [s] of the Newton rows, rows for each (the factorisations' "
                                             "rows take the first)")
       ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app.add_option("--cg-tolerance", cg_tolerance, "the cg rows' seepage.cg_tolerance")
+      ->check(CLI::Range(1e-16, 0.5))
       ->capture_default_str();
   app.add_option("--rounds", rounds, "rounds, each contender's best kept")->check(CLI::Range(1, 100))->capture_default_str();
   app.add_option("--simplicial-up-to", simplicial_up_to, "factorise simplicially only up to this many unknowns")
@@ -227,8 +237,9 @@ int main(int argc, char** argv) {
     return app.exit(e) == 0 ? 0 : 2;
   }
   try {
-    std::FILE* csv = open_csv(csv_path, "unknowns,mesh,time_step_s,linear_solver,method,newton_iterations,"
-                                        "newton_iteration_s,factor_s,solve_s,other_s,over_reference");
+    std::FILE* csv = open_csv(csv_path, "unknowns,mesh,time_step_s,linear_solver,method,cg_tolerance,"
+                                        "newton_iterations,newton_iteration_s,factor_s,solve_s,other_s,"
+                                        "cg_iterations,over_reference");
     std::FILE* orderings = open_csv(orderings_path, "unknowns,mesh,mode,ordering,analyse_s,factor_solve_s,"
                                                     "factor_nonzeros,flops,over_fastest,chosen");
     std::vector<Case> cases;
@@ -237,10 +248,10 @@ int main(int argc, char** argv) {
     std::printf("BLAS: %s; %d rounds, best kept\n", blas::description().c_str(), rounds);
     if (!no_newton) {
       std::printf("\nPer Newton iteration [s] (other: residuals, Jacobian values, line search, bookkeeping)\n");
-      std::printf("%9s %-14s %7s %-7s %-24s %7s %10s %9s %9s %9s %8s\n", "unknowns", "mesh", "dt", "solver", "method",
-                  "Newton", "per it.", "factor", "solve", "other", "/ first");
+      std::printf("%9s %-14s %7s %-7s %-24s %7s %10s %9s %9s %9s %8s %8s\n", "unknowns", "mesh", "dt", "solver", "method",
+                  "Newton", "per it.", "factor", "solve", "other", "cg its", "/ first");
       for (const auto& c : cases)
-        for (double dt : time_steps) newton_rows(c, linear_solvers, dt, rounds, csv);
+        for (double dt : time_steps) newton_rows(c, linear_solvers, dt, cg_tolerance, rounds, csv);
     }
     if (!no_orderings) {
       std::printf("\nCHOLMOD factor-and-solve of the Jacobian\n");
