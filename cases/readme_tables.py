@@ -489,6 +489,25 @@ def seepage_linear_solvers(rows):
     return lines
 
 
+@block("seepage against fenicsx", "seepage_fe/benchmark/fenicsx.csv")
+def seepage_against_fenicsx(rows):
+    """Per Newton iteration, ours and FEniCSx's, how many times faster ours is, and the iterations per step."""
+    contenders = list(dict.fromkeys(r["contender"] for r in rows))
+    lines = ["| unknowns | " + " | ".join(f"{c} [s]" for c in contenders) + " | FEniCSx's best / ours, direct | "
+             "FEniCSx's best / ours, cg | Newton iterations per step: ours / FEniCSx |",
+             "|" + "---|" * (len(contenders) + 4)]
+    sizes = {}
+    for r in rows:
+        sizes.setdefault(int(r["unknowns"]), {})[r["contender"]] = r
+    for n, by in sorted(sizes.items()):
+        ours = float(by["ours, direct"]["newton_iterations"])
+        theirs = float(next(by[c] for c in contenders if c.startswith("FEniCSx"))["newton_iterations"])
+        lines.append(f"| {n} | " + " | ".join(f"{float(by[c]['newton_iteration_s']):.3g}" for c in contenders)
+                     + f" | {float(by['ours, direct']['fenicsx_over_this']):.2f} | "
+                     f"{float(by['ours, cg']['fenicsx_over_this']):.2f} | {ours:.3g} / {theirs:.3g} |")
+    return lines
+
+
 @block("outburst convergence", "cases/outburst/convergence/convergence.csv")
 def outburst_convergence(rows):
     from .outburst.convergence import QUANTITIES, table
