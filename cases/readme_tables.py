@@ -444,6 +444,70 @@ def mpm_benchmark(rows):
     return lines
 
 
+def milliseconds(seconds):
+    ms = 1e3 * seconds
+    return f"{ms:.3g}" if ms < 1000 else f"{ms:.0f}"
+
+
+ORDERINGS = ["amd", "metis", "nesdis", "cholmod_default"]
+
+
+@block("seepage orderings", "seepage_fe/benchmark/orderings.csv")
+def seepage_orderings(rows):
+    """CHOLMOD's factor-and-solve per mode and ordering, the fastest in bold, and the solver's pick."""
+    lines = ["| unknowns | mesh | simplicial: " + " / ".join(ORDERINGS) + " [ms] | supernodal: " + " / ".join(ORDERINGS)
+             + " [ms] | the solver's | its time / the fastest |", "|---|---|---|---|---|---|"]
+    cases = {}
+    for r in rows:
+        cases.setdefault((int(r["unknowns"]), r["mesh"]), {})[(r["mode"], r["ordering"])] = r
+    for (n, mesh), by in sorted(cases.items(), key=lambda c: (c[0][1] != "square", c[0][0])):
+        def cell(mode):
+            if not any(m == mode for m, _ in by):
+                return "not run"
+            times = [float(by[(mode, o)]["factor_solve_s"]) for o in ORDERINGS]
+            return " / ".join(f"**{milliseconds(t)}**" if float(by[(mode, o)]["over_fastest"]) == 1 else milliseconds(t)
+                              for t, o in zip(times, ORDERINGS))
+        chosen = next(r for r in by.values() if r["chosen"] == "1")
+        lines.append(f"| {n} | {mesh} | {cell('simplicial')} | {cell('supernodal')} | "
+                     f"{chosen['mode']}/{chosen['ordering']} | {float(chosen['over_fastest']):.2f} |")
+    return lines
+
+
+@block("seepage linear solvers", "seepage_fe/benchmark/crossover.csv")
+def seepage_linear_solvers(rows):
+    """Per Newton iteration: CHOLMOD against conjugate gradients, by size and time step."""
+    lines = ["| unknowns | mesh | time step | direct [s] | cg [s] | cg iterations per Newton iteration | cg / direct |",
+             "|---|---|---|---|---|---|---|"]
+    cases = {}
+    for r in rows:
+        cases.setdefault((r["mesh"], float(r["time_step_s"]), int(r["unknowns"])), {})[r["linear_solver"]] = r
+    for (mesh, dt, n), by in sorted(cases.items(), key=lambda c: (c[0][0] != "square", c[0][1], c[0][2])):
+        direct, cg = by["direct"], by["cg"]
+        lines.append(f"| {n} | {mesh} | {sci(dt, 0)} s | {float(direct['newton_iteration_s']):.3g} | "
+                     f"{float(cg['newton_iteration_s']):.3g} | {float(cg['cg_iterations']):.0f} | "
+                     f"{float(cg['over_reference']):.2f} |")
+    return lines
+
+
+@block("seepage against fenicsx", "seepage_fe/benchmark/fenicsx.csv")
+def seepage_against_fenicsx(rows):
+    """Per Newton iteration, ours and FEniCSx's, how many times faster ours is, and the iterations per step."""
+    contenders = list(dict.fromkeys(r["contender"] for r in rows))
+    lines = ["| unknowns | " + " | ".join(f"{c} [s]" for c in contenders) + " | FEniCSx's best / ours, direct | "
+             "FEniCSx's best / ours, cg | Newton iterations per step: ours / FEniCSx |",
+             "|" + "---|" * (len(contenders) + 4)]
+    sizes = {}
+    for r in rows:
+        sizes.setdefault(int(r["unknowns"]), {})[r["contender"]] = r
+    for n, by in sorted(sizes.items()):
+        ours = float(by["ours, direct"]["newton_iterations"])
+        theirs = float(next(by[c] for c in contenders if c.startswith("FEniCSx"))["newton_iterations"])
+        lines.append(f"| {n} | " + " | ".join(f"{float(by[c]['newton_iteration_s']):.3g}" for c in contenders)
+                     + f" | {float(by['ours, direct']['fenicsx_over_this']):.2f} | "
+                     f"{float(by['ours, cg']['fenicsx_over_this']):.2f} | {ours:.3g} / {theirs:.3g} |")
+    return lines
+
+
 @block("outburst convergence", "cases/outburst/convergence/convergence.csv")
 def outburst_convergence(rows):
     from .outburst.convergence import QUANTITIES, table

@@ -118,6 +118,22 @@ void read_settings(const scene::Table& s, Setup& setup) {
   // Sixty halvings shrink a step 1e18 times: past any step the clock resolves.
   st.max_step_cuts = s.integer<int>(
       {"max_step_cuts", "halvings of a failing step before the run stops", "12", Range::between(0, 60)});
+  st.linear_solver = s.choice<LinearSolver>(
+      {"linear_solver",
+       "the Newton systems: \"direct\" (CHOLMOD, its mode and ordering picked by size) or \"cg\" (conjugate "
+       "gradients with an incomplete Cholesky preconditioner)",
+       "direct"},
+      {{"direct", LinearSolver::direct}, {"cg", LinearSolver::cg}});
+  if (st.linear_solver == LinearSolver::cg) {
+    st.cg_tolerance = s.number({"cg_tolerance", "conjugate gradients stop at ||J du + r|| <= cg_tolerance ||r||",
+                                "1e-8", Range{0.0, 1.0, false, false}});
+    st.cg_max_iterations = s.integer<int>({"cg_max_iterations",
+                                           "conjugate gradient iterations before the step is cut and retried",
+                                           "5000", Range::between(1, 1e7)});
+  } else {
+    for (const char* key : {"cg_tolerance", "cg_max_iterations"})
+      if (s.has(key)) s.fail(key, "applies to conjugate gradients only: set seepage.linear_solver = \"cg\"");
+  }
 
 }
 

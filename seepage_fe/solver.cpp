@@ -17,13 +17,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// CHOLMOD's simplicial factorisation is faster on small meshes and its
-// supernodal one (nested dissection, BLAS) on large ones; the switch sits
-// where their times cross on the benchmark's Jacobian
-// (seepage_fe/benchmark/crossover.csv: `seepage-benchmark --csv` writes the
-// simplicial / supernodal time per size).
-constexpr std::size_t supernodal_threshold = 10000;
-
 // Adds the wall time of its scope to a counter.
 class ScopedTimer {
  public:
@@ -36,6 +29,40 @@ class ScopedTimer {
 };
 
 }  // namespace
+
+// The fastest numeric factorisation by size, read from
+// seepage_fe/benchmark/orderings.csv (`seepage-benchmark --orderings-csv`, on
+// the unit square and the outburst's meshes; the README tables it). Below
+// about 5000 unknowns simplicial: its loops beat supernodal's BLAS calls, and
+// the orderings tie, so AMD, the quickest to compute. From there supernodal
+// with CHOLMOD's nested dissection: the fewest flops (to 1 %) and the fastest
+// or within 11 % of it (the noise) at every size to 1e6. Its analysis, the slowest
+// (seconds at 1e6), is done once per run.
+Factorisation factorisation_for(std::size_t unknowns) {
+  using F = Factorisation;
+  if (unknowns < 5000) return {F::Mode::simplicial, F::Ordering::amd};
+  return {F::Mode::supernodal, F::Ordering::nesdis};
+}
+
+std::string Factorisation::name() const {
+  static constexpr const char* orderings[] = {"amd", "metis", "nesdis", "cholmod_default"};
+  return fmt::format("{}/{}", mode == Mode::simplicial ? "simplicial" : "supernodal",
+                     orderings[static_cast<int>(ordering)]);
+}
+
+void configure(Cholmod& factor, Factorisation f) {
+  factor.setMode(f.mode == Factorisation::Mode::simplicial ? Eigen::CholmodSimplicialLLt
+                                                           : Eigen::CholmodSupernodalLLt);
+  cholmod_common& c = factor.cholmod();
+  if (f.ordering == Factorisation::Ordering::cholmod_default) {
+    c.nmethods = 0;
+    return;
+  }
+  c.nmethods = 1;
+  c.method[0].ordering = f.ordering == Factorisation::Ordering::amd     ? CHOLMOD_AMD
+                         : f.ordering == Factorisation::Ordering::metis ? CHOLMOD_METIS
+                                                                        : CHOLMOD_NESDIS;
+}
 
 double Balance::error() const {
   double inflow = inflow_through_flux;
@@ -136,18 +163,16 @@ void Solver::setup_system() {
 
   jacobian_ = stiffness_;
   assemble_conductivity();
-  // Supernodal CHOLMOD pays off on large systems only; below that its BLAS calls
-  // cost more than the work (simplicial is 3x faster at 1e4 unknowns). Large
-  // systems are ordered by nested dissection: a slower analysis, done once, for
-  // a factorisation repeated every Newton iteration.
   blas::set_threads_for(static_cast<long>(n));
-  const bool supernodal = this->supernodal();
-  factor_.setMode(supernodal ? Eigen::CholmodSupernodalLLt : Eigen::CholmodSimplicialLLt);
-  if (supernodal) {
-    factor_.cholmod().nmethods = 1;
-    factor_.cholmod().method[0].ordering = CHOLMOD_NESDIS;
+  if (settings_.linear_solver == LinearSolver::direct) {
+    factorisation_ = factorisation_for(n);
+    configure(factor_, factorisation_);
+    factor_.analyzePattern(jacobian_);
+  } else {
+    incomplete_.analyzePattern(jacobian_);
+    for (auto* v : {&cg_residual_, &cg_direction_, &cg_preconditioned_, &cg_product_})
+      v->setZero(static_cast<Eigen::Index>(n));
   }
-  factor_.analyzePattern(jacobian_);
   const std::size_t size = n;
   for (auto* v : {&trial_, &history_, &load_, &r_, &delta_, &candidate_})
     v->setZero(static_cast<Eigen::Index>(size));
@@ -363,23 +388,15 @@ std::optional<std::string> Solver::try_step(double h, int& iterations) {
                        factor_key_.version == conductivity_version_;
     if (!reuse) {
       build_jacobian(trial_, a0, h);
-      {
-        ScopedTimer timer(timings_.factorization);
-        blas::without_openmp_regions([&] { factor_.factorize(jacobian_); });
-        ++timings_.factorizations;
-      }
-      if (factor_.info() != Eigen::Success) {
+      if (auto failure = factorise()) {
         factor_key_ = {};
-        return "the Jacobian is not positive definite (CHOLMOD could not factorise it)";
+        return failure;
       }
       factor_key_ = linear ? FactorKey{h, a0, conductivity_version_} : FactorKey{};
     }
-    {
-      ScopedTimer timer(timings_.solve);
-      for (Eigen::Index i = 0; i < r_.size(); ++i)
-        if (fixed_by_[i] >= 0) r_[i] = 0;
-      delta_ = factor_.solve(-r_);
-    }
+    for (Eigen::Index i = 0; i < r_.size(); ++i)
+      if (fixed_by_[i] >= 0) r_[i] = 0;
+    if (auto failure = solve_newton_system()) return failure;
     if (!delta_.allFinite()) return "the Newton update is not finite";
 
     // Keep the gas law's P positive: never step more than 90% of the way to zero.
@@ -484,7 +501,62 @@ StepReport Solver::advance(double dt) {
   return report;
 }
 
-bool Solver::supernodal() const { return mesh_.num_nodes() >= supernodal_threshold; }
+std::optional<std::string> Solver::factorise() {
+  ScopedTimer timer(timings_.factorization);
+  ++timings_.factorizations;
+  if (settings_.linear_solver == LinearSolver::cg) {
+    incomplete_.factorize(jacobian_);
+    if (incomplete_.info() != Eigen::Success)
+      return "the incomplete Cholesky preconditioner could not be computed (is the Jacobian positive definite?)";
+    return std::nullopt;
+  }
+  blas::without_openmp_regions([&] { factor_.factorize(jacobian_); });
+  if (factor_.info() != Eigen::Success) return "the Jacobian is not positive definite (CHOLMOD could not factorise it)";
+  return std::nullopt;
+}
+
+std::optional<std::string> Solver::solve_newton_system() {
+  ScopedTimer timer(timings_.solve);
+  if (settings_.linear_solver == LinearSolver::cg) return conjugate_gradients();
+  delta_ = factor_.solve(-r_);
+  return std::nullopt;
+}
+
+// J delta = -r from delta = 0 by preconditioned conjugate gradients, stopped
+// on the recurrence's residual. On one thread: Eigen's threaded (row-major)
+// product measured slower on this 2-core machine under load, 30x at 1e4
+// unknowns and 1.2x at 1e6, as OpenBLAS's threads are on small systems.
+std::optional<std::string> Solver::conjugate_gradients() {
+  delta_.setZero();
+  cg_residual_ = -r_;
+  const double b2 = cg_residual_.squaredNorm();
+  const double target = std::pow(settings_.cg_tolerance, 2) * b2;
+  if (b2 == 0) return std::nullopt;
+  cg_preconditioned_ = incomplete_.solve(cg_residual_);
+  cg_direction_ = cg_preconditioned_;
+  double rz = cg_residual_.dot(cg_preconditioned_);
+  double r2 = b2;
+  for (int k = 1; k <= settings_.cg_max_iterations; ++k) {
+    ++timings_.linear_iterations;
+    cg_product_.noalias() = jacobian_ * cg_direction_;
+    const double curvature = cg_direction_.dot(cg_product_);
+    if (!(curvature > 0))
+      return fmt::format("the Jacobian is not positive definite (conjugate gradients met p'Jp = {:.3e})", curvature);
+    const double alpha = rz / curvature;
+    delta_ += alpha * cg_direction_;
+    cg_residual_ -= alpha * cg_product_;
+    r2 = cg_residual_.squaredNorm();
+    if (r2 <= target) return std::nullopt;
+    cg_preconditioned_ = incomplete_.solve(cg_residual_);
+    const double rz_next = cg_residual_.dot(cg_preconditioned_);
+    cg_direction_ = cg_preconditioned_ + (rz_next / rz) * cg_direction_;
+    rz = rz_next;
+  }
+  return fmt::format("conjugate gradients reached a relative residual of {:.2e} in seepage.cg_max_iterations = {} "
+                     "iterations, short of seepage.cg_tolerance = {:.2e}",
+                     std::sqrt(r2 / b2), settings_.cg_max_iterations,
+                     settings_.cg_tolerance);
+}
 
 std::optional<double> Solver::pressure_at(const Eigen::Vector2d& x) const {
   const auto s = sampler_.sample(u_, x);

@@ -1,22 +1,30 @@
-// seepage-benchmark: where the time of a seepage step goes, beside a bare
-// CHOLMOD factor-and-solve of the same Jacobian in the same run.
+// seepage-benchmark: the seepage solver's Newton iterations under each linear
+// solver, and CHOLMOD's factorisation of their Jacobian under each mode and
+// ordering, measured in one run.
 //
-// Problem (as the issue fixes it): unit square, A = 2, lambda = 0.1, P0 = 9
-// (p0 = 3), the left side drained to p = 1, backward Euler, Newton.
-// Usage: seepage-benchmark [--csv FILE] [cells per side ...]   (default 99 315 999: 1e4..1e6 unknowns; --help)
+// Problem (as issue 2 fixed it): unit square, A = 2, lambda = 0.1, P0 = 9
+// (p0 = 3), the left side drained to p = 1, backward Euler, Newton, steps of
+// --time-step (1e-3 by default). --mesh adds Gmsh meshes: every region that material, the mesh's
+// first boundary drained.
+//
+// The machine may be shared: contenders alternate within each round and each
+// keeps its best round, so a burst of load elsewhere costs a round, not a row.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include <CLI/CLI.hpp>
-#include <Eigen/CholmodSupport>
 
 #include "common/blas.hpp"
 #include "seepage_fe/solver.hpp"
 
 using namespace outburst;
 using Clock = std::chrono::steady_clock;
+using seepage::Factorisation;
 
 namespace {
 
@@ -24,109 +32,238 @@ double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-// Median-free and simple: the mean of `reps` factor-and-solve calls.
-double bare_factor_and_solve(const Eigen::SparseMatrix<double>& j, int mode, int reps) {
-  Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::Lower> f;
-  f.setMode(static_cast<Eigen::CholmodMode>(mode));
-  const Eigen::VectorXd b = Eigen::VectorXd::Ones(j.rows());
+struct Case {
+  std::string mesh_name;  // "square" or the Gmsh file's name
+  seepage::Mesh mesh;
+  seepage::Model model;
+};
+
+seepage::Model benchmark_model(const seepage::Mesh& mesh) {
+  seepage::Model model;
+  model.law = seepage::Law::gas;
+  model.materials.assign(mesh.region_names.size(), {0.1, 2.0, 3.0});
+  model.boundary_conditions = {
+      {mesh.boundary_names().front(), seepage::BoundaryCondition::Type::pressure, TimeFunction(1.0)}};
+  return model;
+}
+
+Case square(int cells) {
+  seepage::StructuredMeshSpec spec;
+  spec.cells = {cells, cells};
+  spec.regions = {{"square", true, {}, {}}};
+  Case c{"square", seepage::make_structured_mesh(spec), {}};
+  c.model = benchmark_model(c.mesh);
+  return c;
+}
+
+Case gmsh(const std::string& path) {
+  Case c{path.substr(path.find_last_of('/') + 1), seepage::read_gmsh(path, 1.0), {}};
+  if (c.mesh.boundary_names().empty()) throw std::runtime_error(path + ": the mesh names no boundary to drain");
+  c.model = benchmark_model(c.mesh);
+  return c;
+}
+
+// ---- the solver's Newton iterations, one contender per linear solver
+
+struct Contender {
+  std::string linear_solver;
+  std::unique_ptr<seepage::Solver> solver;
+  seepage::Timings best{};  // the round with the cheapest Newton iteration
+  double best_per_iteration = std::numeric_limits<double>::infinity();
+  long steps = 0;
+};
+
+seepage::Timings minus(const seepage::Timings& a, const seepage::Timings& b) {
+  seepage::Timings d;
+  d.factorization = a.factorization - b.factorization;
+  d.solve = a.solve - b.solve;
+  d.total_step = a.total_step - b.total_step;
+  d.nonlinear_iterations = a.nonlinear_iterations - b.nonlinear_iterations;
+  d.linear_iterations = a.linear_iterations - b.linear_iterations;
+  return d;
+}
+
+void newton_rows(const Case& c, const std::vector<std::string>& linear_solvers, double dt, double cg_tolerance,
+                 int rounds, std::FILE* csv) {
+  std::vector<Contender> contenders;
+  for (const auto& name : linear_solvers) {
+    seepage::Settings settings;
+    settings.scheme = seepage::TimeScheme::backward_euler;
+    settings.linear_solver = name == "cg" ? seepage::LinearSolver::cg : seepage::LinearSolver::direct;
+    settings.cg_tolerance = cg_tolerance;
+    contenders.push_back({name, std::make_unique<seepage::Solver>(c.mesh, c.model, settings)});
+    contenders.back().solver->advance(dt);  // first touch of every array
+  }
+  for (int r = 0; r < rounds; ++r)
+    for (auto& k : contenders) {
+      const auto before = k.solver->timings();
+      k.solver->advance(dt);
+      const auto d = minus(k.solver->timings(), before);
+      const double per_iteration = d.total_step / static_cast<double>(d.nonlinear_iterations);
+      ++k.steps;
+      if (per_iteration < k.best_per_iteration) {
+        k.best_per_iteration = per_iteration;
+        k.best = d;
+      }
+    }
+  const double direct = contenders.front().best_per_iteration;
+  for (const auto& k : contenders) {
+    const auto& t = k.best;
+    const double its = static_cast<double>(t.nonlinear_iterations);
+    const std::string method =
+        k.linear_solver == "cg" ? "cg/incomplete_cholesky" : k.solver->factorisation().name();
+    const long unknowns = static_cast<long>(c.mesh.num_nodes());
+    const double cg_iterations = static_cast<double>(t.linear_iterations) / its;
+    std::printf("%9ld %-14s %7.0e %-7s %-24s %7.0f %10.4f %9.4f %9.4f %9.4f %8.1f %8.3f\n", unknowns,
+                c.mesh_name.c_str(), dt, k.linear_solver.c_str(), method.c_str(), its, k.best_per_iteration,
+                t.factorization / its, t.solve / its, (t.total_step - t.factorization - t.solve) / its,
+                cg_iterations, k.best_per_iteration / direct);
+    std::fflush(stdout);
+    if (csv)
+      std::fprintf(csv, "%ld,%s,%g,%s,%s,%g,%.0f,%.6g,%.6g,%.6g,%.6g,%.1f,%.4f\n", unknowns, c.mesh_name.c_str(),
+                   dt, k.linear_solver.c_str(), method.c_str(), k.linear_solver == "cg" ? cg_tolerance : 0.0, its,
+                   k.best_per_iteration, t.factorization / its, t.solve / its,
+                   (t.total_step - t.factorization - t.solve) / its, cg_iterations, k.best_per_iteration / direct);
+  }
+}
+
+// ---- CHOLMOD alone on the solver's Jacobian, every mode and ordering
+
+struct Variant {
+  Factorisation f;
+  std::unique_ptr<seepage::Cholmod> factor;
+  double analyse_s = 0, factor_nonzeros = 0, flops = 0;
+  double best = std::numeric_limits<double>::infinity();
+};
+
+void ordering_rows(const Case& c, double dt, long simplicial_up_to, int rounds, std::FILE* csv) {
+  seepage::Settings settings;
+  settings.scheme = seepage::TimeScheme::backward_euler;
+  seepage::Solver solver(c.mesh, c.model, settings);
+  solver.advance(dt);  // the Jacobian of a Newton iteration
+  const auto& j = solver.jacobian();
+  const long unknowns = j.rows();
+  std::vector<Variant> variants;
+  for (auto mode : {Factorisation::Mode::simplicial, Factorisation::Mode::supernodal}) {
+    if (mode == Factorisation::Mode::simplicial && unknowns > simplicial_up_to) continue;
+    for (auto ordering : {Factorisation::Ordering::amd, Factorisation::Ordering::metis,
+                          Factorisation::Ordering::nesdis, Factorisation::Ordering::cholmod_default}) {
+      Variant v{{mode, ordering}, std::make_unique<seepage::Cholmod>()};
+      seepage::configure(*v.factor, v.f);
+      const auto start = Clock::now();
+      v.factor->analyzePattern(j);
+      v.analyse_s = seconds_since(start);
+      v.factor_nonzeros = v.factor->cholmod().lnz;
+      v.flops = v.factor->cholmod().fl;
+      variants.push_back(std::move(v));
+    }
+  }
+  const Eigen::VectorXd b = Eigen::VectorXd::Ones(unknowns);
   Eigen::VectorXd x;
-  if (mode == Eigen::CholmodSupernodalLLt) {  // as the solver configures it
-    f.cholmod().nmethods = 1;
-    f.cholmod().method[0].ordering = CHOLMOD_NESDIS;
+  for (int r = 0; r < rounds; ++r)
+    for (auto& v : variants) {
+      const auto start = Clock::now();
+      blas::without_openmp_regions([&] { v.factor->factorize(j); });
+      x = v.factor->solve(b);
+      v.best = std::min(v.best, seconds_since(start));
+      if (v.factor->info() != Eigen::Success) std::fprintf(stderr, "%s failed\n", v.f.name().c_str());
+    }
+  double fastest = std::numeric_limits<double>::infinity();
+  for (const auto& v : variants) fastest = std::min(fastest, v.best);
+  const std::string chosen = seepage::factorisation_for(static_cast<std::size_t>(unknowns)).name();
+  for (const auto& v : variants) {
+    const std::string name = v.f.name();
+    std::printf("%9ld %-14s %-28s %9.4f %10.5f %10.3g %10.3g %8.3f%s\n", unknowns, c.mesh_name.c_str(),
+                name.c_str(), v.analyse_s, v.best, v.factor_nonzeros, v.flops, v.best / fastest,
+                name == chosen ? "  <- the solver's" : "");
+    if (csv)
+      std::fprintf(csv, "%ld,%s,%s,%s,%.6g,%.6g,%.6g,%.6g,%.4f,%d\n", unknowns, c.mesh_name.c_str(),
+                   name.substr(0, name.find('/')).c_str(), name.substr(name.find('/') + 1).c_str(), v.analyse_s,
+                   v.best, v.factor_nonzeros, v.flops, v.best / fastest, name == chosen ? 1 : 0);
   }
-  f.analyzePattern(j);
-  const auto start = Clock::now();
-  for (int r = 0; r < reps; ++r) {
-    blas::without_openmp_regions([&] { f.factorize(j); });
-    x = f.solve(b);
-  }
-  if (f.info() != Eigen::Success) std::fprintf(stderr, "bare factorisation failed\n");
-  return seconds_since(start) / reps;
+  std::fflush(stdout);
+}
+
+std::FILE* open_csv(const std::string& path, const char* header) {
+  if (path.empty()) return nullptr;
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  if (!f) throw std::runtime_error("cannot write " + path);
+  std::fprintf(f, "%s\n", header);
+  return f;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app("Where the time of a seepage step goes, beside a bare CHOLMOD factor-and-solve of the same Jacobian",
+  CLI::App app("The seepage solver's Newton iterations under each linear solver, and CHOLMOD's factorisation of "
+               "their Jacobian under each mode and ordering",
                "seepage-benchmark");
   std::vector<int> sides{99, 315, 999};
-  std::string csv_path;
-  app.add_option("cells", sides, "cells per side of the unit square, one row each (unknowns: (n + 1)^2)")
+  std::vector<std::string> meshes, linear_solvers{"direct", "cg"};
+  std::string csv_path, orderings_path;
+  std::vector<double> time_steps{1e-3};
+  double cg_tolerance = seepage::Settings{}.cg_tolerance;
+  int rounds = 3;
+  long simplicial_up_to = std::numeric_limits<long>::max();
+  bool no_newton = false, no_orderings = false;
+  app.add_option("cells", sides, "cells per side of the unit square, one case each (unknowns: (n + 1)^2)")
       ->check(CLI::Range(2, 4000))
       ->capture_default_str();
-  app.add_option("--csv", csv_path, "also write the rows to this CSV file (seepage_fe/benchmark/crossover.csv is "
-                                    "one, from which the solver's switch between CHOLMOD modes is set)");
+  app.add_option("--mesh", meshes, "a Gmsh MSH 4.1 mesh, one case each, after the squares")->check(CLI::ExistingFile);
+  app.add_option("--csv", csv_path,
+                 "write the Newton iterations' rows to this CSV (seepage_fe/benchmark/crossover.csv is one)");
+  app.add_option("--orderings-csv", orderings_path,
+                 "write the factorisations' rows to this CSV (seepage_fe/benchmark/orderings.csv is one, from which "
+                 "the solver's choice of mode and ordering is set)");
+  app.add_option("--linear-solvers", linear_solvers, "linear solvers of the Newton rows, the first the reference")
+      ->check(CLI::IsMember({"direct", "cg"}))
+      ->capture_default_str();
+  app.add_option("--time-step", time_steps, "time steps [s] of the Newton rows, rows for each (the factorisations' "
+                                            "rows take the first)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app.add_option("--cg-tolerance", cg_tolerance, "the cg rows' seepage.cg_tolerance")
+      ->check(CLI::Range(1e-16, 0.5))
+      ->capture_default_str();
+  app.add_option("--rounds", rounds, "rounds, each contender's best kept")->check(CLI::Range(1, 100))->capture_default_str();
+  app.add_option("--simplicial-up-to", simplicial_up_to, "factorise simplicially only up to this many unknowns")
+      ->check(CLI::PositiveNumber);
+  app.add_flag("--no-newton", no_newton, "skip the Newton rows");
+  app.add_flag("--no-orderings", no_orderings, "skip the factorisations' rows");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     // --help is a success; anything else is a bad command line (exit code 2, as every program here).
     return app.exit(e) == 0 ? 0 : 2;
   }
-  std::FILE* csv = nullptr;
-  if (!csv_path.empty()) {
-    csv = std::fopen(csv_path.c_str(), "w");
-    if (!csv) {
-      std::fprintf(stderr, "seepage-benchmark: cannot write %s\n", csv_path.c_str());
-      return 2;
+  try {
+    std::FILE* csv = open_csv(csv_path, "unknowns,mesh,time_step_s,linear_solver,method,cg_tolerance,"
+                                        "newton_iterations,newton_iteration_s,factor_s,solve_s,other_s,"
+                                        "cg_iterations,over_reference");
+    std::FILE* orderings = open_csv(orderings_path, "unknowns,mesh,mode,ordering,analyse_s,factor_solve_s,"
+                                                    "factor_nonzeros,flops,over_fastest,chosen");
+    std::vector<Case> cases;
+    for (int n : sides) cases.push_back(square(n));
+    for (const auto& m : meshes) cases.push_back(gmsh(m));
+    std::printf("BLAS: %s; %d rounds, best kept\n", blas::description().c_str(), rounds);
+    if (!no_newton) {
+      std::printf("\nPer Newton iteration [s] (other: residuals, Jacobian values, line search, bookkeeping)\n");
+      std::printf("%9s %-14s %7s %-7s %-24s %7s %10s %9s %9s %9s %8s %8s\n", "unknowns", "mesh", "dt", "solver", "method",
+                  "Newton", "per it.", "factor", "solve", "other", "cg its", "/ first");
+      for (const auto& c : cases)
+        for (double dt : time_steps) newton_rows(c, linear_solvers, dt, cg_tolerance, rounds, csv);
     }
-    std::fprintf(csv, "unknowns,mode,step_s,newton_iteration_s,factor_s,solve_s,other_s,bare_s,"
-                      "simplicial_over_supernodal\n");
-  }
-  std::printf("BLAS: %s\n\n", blas::description().c_str());
-  std::printf("%9s %7s %9s %9s %9s %9s %9s %9s %7s %10s %10s %12s\n", "unknowns", "mode", "step[s]",
-              "newton[s]", "factor[s]", "solve[s]", "other[s]", "bare[s]", "other/", "assembly",
-              "assembly", "simplicial/");
-  std::printf("%9s %7s %9s %9s %9s %9s %9s %9s %7s %10s %10s %12s\n", "", "", "", "iteration",
-              "per it.", "per it.", "per it.", "fact+solve", "factor", "[s]", "[ns/cell]",
-              "supernodal");
-  for (int n : sides) {
-    seepage::StructuredMeshSpec spec;
-    spec.cells = {n, n};
-    spec.regions = {{"square", true, {}, {}}};
-    seepage::Model model;
-    model.law = seepage::Law::gas;
-    model.materials = {{0.1, 2.0, 3.0}};
-    model.boundary_conditions = {{"left", seepage::BoundaryCondition::Type::pressure, TimeFunction(1.0)}};
-    seepage::Settings settings;
-    settings.scheme = seepage::TimeScheme::backward_euler;
-    seepage::Solver solver(seepage::make_structured_mesh(spec), model, settings);
-    const long unknowns = static_cast<long>(solver.mesh().num_nodes());
-
-    const int steps = 2;
-    for (int s = 0; s < steps; ++s) solver.advance(1e-3);
-    const auto& t = solver.timings();
-    const double iterations = static_cast<double>(t.nonlinear_iterations);
-    const double factor = t.factorization / iterations;
-    const double solve = t.solve / iterations;
-    const double other = (t.total_step - t.factorization - t.solve) / iterations;
-
-    // Re-assembly of the conductivity matrix, as the coupler triggers it.
-    const auto start = Clock::now();
-    const int assemblies = 5;
-    for (int a = 0; a < assemblies; ++a) solver.set_conductivity(std::vector<double>(solver.mesh().num_cells(), 0.1 + 1e-3 * a));
-    const double assembly = seconds_since(start) / assemblies;
-
-    const bool supernodal = solver.supernodal();
-    const double bare = bare_factor_and_solve(solver.jacobian(), supernodal ? Eigen::CholmodSupernodalLLt
-                                                                            : Eigen::CholmodSimplicialLLt, 3);
-    // Both CHOLMOD modes on the same matrix, to place the switch between them.
-    const double simplicial = bare_factor_and_solve(solver.jacobian(), Eigen::CholmodSimplicialLLt, 2);
-    const double super = bare_factor_and_solve(solver.jacobian(), Eigen::CholmodSupernodalLLt, 2);
-    std::printf("%9ld %7s %9.4f %9.4f %9.4f %9.4f %9.4f %9.4f %7.3f %10.4f %10.1f %12.2f\n", unknowns,
-                supernodal ? "super" : "simpl", t.total_step / steps, t.total_step / iterations, factor, solve,
-                other, bare, other / factor, assembly, 1e9 * assembly / static_cast<double>(solver.mesh().num_cells()),
-                simplicial / super);
-    std::fflush(stdout);
-    if (csv)
-      std::fprintf(csv, "%ld,%s,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.4f\n", unknowns,
-                   supernodal ? "supernodal" : "simplicial", t.total_step / steps, t.total_step / iterations, factor,
-                   solve, other, bare, simplicial / super);
-  }
-  if (csv && std::fclose(csv) != 0) {
-    std::fprintf(stderr, "seepage-benchmark: the CSV could not be written in full\n");
+    if (!no_orderings) {
+      std::printf("\nCHOLMOD factor-and-solve of the Jacobian\n");
+      std::printf("%9s %-14s %-28s %9s %10s %10s %10s %8s\n", "unknowns", "mesh", "mode/ordering", "analyse",
+                  "factor+solve", "nnz(L)", "flops", "/ best");
+      for (const auto& c : cases) ordering_rows(c, time_steps.front(), simplicial_up_to, rounds, orderings);
+    }
+    for (std::FILE* f : {csv, orderings})
+      if (f && std::fclose(f) != 0) throw std::runtime_error("a CSV could not be written in full");
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "seepage-benchmark: %s\n", e.what());
     return 1;
   }
-  std::printf("\nother = assembly, residuals, Jacobian values, line search and bookkeeping per Newton "
-              "iteration;\ngoal: other/factor <= 0.5 and assembly ns/cell flat across sizes.\n");
   return 0;
 }

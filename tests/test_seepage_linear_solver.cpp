@@ -1,0 +1,134 @@
+// The Newton systems' linear solvers: conjugate gradients (seepage.linear_solver
+// = "cg") must leave the discretisation's answers as CHOLMOD leaves them (the
+// manufactured solution's order, the gas balance), and fail loudly when they
+// cannot reach their tolerance; every CHOLMOD mode and ordering the benchmark
+// measures must solve the Jacobian.
+#include <catch2/catch.hpp>
+
+#include "convergence.hpp"
+#include "seepage_manufactured.hpp"
+
+using namespace outburst;
+using namespace outburst::testing;
+
+namespace {
+
+seepage::Settings with_cg(seepage::Settings settings = {}) {
+  settings.linear_solver = seepage::LinearSolver::cg;
+  return settings;
+}
+
+}  // namespace
+
+TEST_CASE("with conjugate gradients Q1 keeps its second order on the manufactured gas solution",
+          "[seepage][cg][mms]") {
+  using namespace manufactured_gas;
+  const double T = 0.5;
+  std::vector<ConvergenceRow> rows;
+  for (int n : {8, 16, 32, 64}) {
+    auto cg = manufactured(n, with_cg());
+    auto direct = manufactured(n, {});
+    for (int k = 0; k < 250; ++k) {  // BDF2 with dt = 2e-3: time error far below the spatial
+      cg->advance(T / 250);
+      direct->advance(T / 250);
+    }
+    rows.push_back({1.0 / n, l2_error(*cg, T)});
+    INFO("n = " << n);
+    CHECK(cg->timings().linear_iterations > 0);
+    std::printf("n = %d: Newton iterations %ld (cg) %ld (direct), cg iterations per Newton iteration %.1f\n", n,
+                cg->timings().nonlinear_iterations, direct->timings().nonlinear_iterations,
+                double(cg->timings().linear_iterations) / double(cg->timings().nonlinear_iterations));
+    // Solved to 1e-8, each Newton system is as good as solved exactly: Newton's
+    // convergence is left as it was.
+    CHECK(cg->timings().nonlinear_iterations <= 1.02 * direct->timings().nonlinear_iterations);
+    // Both converge Newton to the same tolerance: their answers are one answer.
+    CHECK((cg->unknown() - direct->unknown()).lpNorm<Eigen::Infinity>() < 1e-9 * direct->unknown().lpNorm<Eigen::Infinity>());
+  }
+  print_convergence("seepage MMS, space, conjugate gradients (BDF2, dt = 2e-3)", "h", rows);
+  for (double order : observed_orders(rows)) CHECK(order == Approx(2.0).margin(0.1));
+}
+
+TEST_CASE("with conjugate gradients stored gas plus what crossed the boundary stays constant",
+          "[seepage][cg][balance]") {
+  // As the direct solver's test (test_seepage_api.cpp): a time-varying face
+  // pressure, an injected flux and uneven steps under both schemes and methods.
+  for (auto scheme : {seepage::TimeScheme::backward_euler, seepage::TimeScheme::bdf2})
+    for (auto method : {seepage::NonlinearMethod::newton, seepage::NonlinearMethod::picard}) {
+      seepage::Settings settings = with_cg();
+      settings.scheme = scheme;
+      settings.method = method;
+      settings.max_iterations = 200;
+      const seepage::BoundaryCondition face{"left", seepage::BoundaryCondition::Type::pressure,
+                                            TimeFunction({{0.0, 3e6}, {3600.0, 1e5}, {20000.0, 5e5}})};
+      const seepage::BoundaryCondition inflow{"right", seepage::BoundaryCondition::Type::flux, TimeFunction(1e-6)};
+      auto s = rectangle_solver(seepage::Law::gas, {10, 2}, {30, 4}, {1e-17, 2e-3, 3e6}, {face, inflow}, settings,
+                                {5.0, 1.0});
+      double dt = 60;
+      INFO("scheme " << int(scheme) << " method " << int(method));
+      for (int i = 0; i < 30; ++i) {
+        s.advance(dt);
+        dt *= (i % 3 == 0) ? 0.7 : 1.6;
+        const auto& b = s.balance();
+        REQUIRE(std::abs(b.error()) < 1e-11 * b.initial_stored);
+      }
+      CHECK(s.timings().linear_iterations > 0);
+      CHECK(s.balance().total_outflow() > 0);
+    }
+}
+
+TEST_CASE("conjugate gradients solve the linear law as CHOLMOD does, reusing their preconditioner",
+          "[seepage][cg][linear]") {
+  // Darcy flow: the Jacobian depends on the step alone, so equal steps factorise once.
+  const seepage::Material rock{1e-15 / 1e-3, 1e-9, 1e6};
+  auto cg = rectangle_solver(seepage::Law::linear, {10, 1}, {40, 4}, rock, {fixed_pressure("left", 1e5)}, with_cg());
+  auto direct = rectangle_solver(seepage::Law::linear, {10, 1}, {40, 4}, rock, {fixed_pressure("left", 1e5)});
+  for (int k = 0; k < 10; ++k) {
+    cg.advance(0.5);
+    direct.advance(0.5);
+  }
+  CHECK(cg.timings().factorizations == direct.timings().factorizations);
+  CHECK((cg.unknown() - direct.unknown()).lpNorm<Eigen::Infinity>() < 1e-9 * 1e6);
+}
+
+TEST_CASE("conjugate gradients that cannot reach their tolerance cut the step, then stop the run with the keys named",
+          "[seepage][cg][robust]") {
+  seepage::Settings settings = with_cg();
+  settings.cg_max_iterations = 3;
+  settings.max_step_cuts = 2;
+  auto s = rectangle_solver(seepage::Law::gas, {10, 1}, {100, 4}, {1e-17, 2e-3, 1e7}, {fixed_pressure("left", 1e5)},
+                            settings);
+  CHECK_THROWS_WITH(s.advance(86400), Catch::Contains("could not be completed") &&
+                                          Catch::Contains("halved 2 times") &&
+                                          Catch::Contains("seepage.cg_max_iterations = 3") &&
+                                          Catch::Contains("short of seepage.cg_tolerance"));
+  CHECK(s.time() == 0);
+}
+
+TEST_CASE("every CHOLMOD mode and ordering solves the seepage Jacobian", "[seepage][direct]") {
+  auto s = rectangle_solver(seepage::Law::gas, {1, 1}, {30, 30}, {0.1, 2.0, 3.0}, {fixed_pressure("left", 1.0)});
+  s.advance(1e-3);
+  const auto& j = s.jacobian();
+  const Eigen::VectorXd x = Eigen::VectorXd::LinSpaced(j.rows(), 1.0, 2.0);
+  const Eigen::VectorXd b = j.selfadjointView<Eigen::Lower>() * x;
+  using F = seepage::Factorisation;
+  for (auto mode : {F::Mode::simplicial, F::Mode::supernodal})
+    for (auto ordering : {F::Ordering::amd, F::Ordering::metis, F::Ordering::nesdis, F::Ordering::cholmod_default}) {
+      const F f{mode, ordering};
+      seepage::Cholmod factor;
+      seepage::configure(factor, f);
+      factor.compute(j);
+      INFO(f.name());
+      REQUIRE(factor.info() == Eigen::Success);
+      CHECK((factor.solve(b) - x).lpNorm<Eigen::Infinity>() < 1e-12);
+      // The ordering CHOLMOD used, and its mode, are the ones asked for.
+      const cholmod_common& c = factor.cholmod();
+      const int used = c.method[c.selected].ordering;
+      if (ordering == F::Ordering::cholmod_default)
+        CHECK((used == CHOLMOD_AMD || used == CHOLMOD_METIS));
+      else
+        CHECK(used == (ordering == F::Ordering::amd     ? CHOLMOD_AMD
+                       : ordering == F::Ordering::metis ? CHOLMOD_METIS
+                                                        : CHOLMOD_NESDIS));
+      CHECK(c.supernodal == (mode == F::Mode::simplicial ? CHOLMOD_SIMPLICIAL : CHOLMOD_SUPERNODAL));
+    }
+}
