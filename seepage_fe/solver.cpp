@@ -169,9 +169,9 @@ void Solver::setup_system() {
     configure(factor_, factorisation_);
     factor_.analyzePattern(jacobian_);
   } else {
-    incomplete_.analyzePattern(jacobian_);
-    for (auto* v : {&cg_residual_, &cg_direction_, &cg_preconditioned_, &cg_product_})
-      v->setZero(static_cast<Eigen::Index>(n));
+    cg_.setTolerance(settings_.cg_tolerance);
+    cg_.setMaxIterations(settings_.cg_max_iterations);
+    cg_.analyzePattern(jacobian_);
   }
   const std::size_t size = n;
   for (auto* v : {&trial_, &history_, &load_, &r_, &delta_, &candidate_})
@@ -505,8 +505,8 @@ std::optional<std::string> Solver::factorise() {
   ScopedTimer timer(timings_.factorization);
   ++timings_.factorizations;
   if (settings_.linear_solver == LinearSolver::cg) {
-    incomplete_.factorize(jacobian_);
-    if (incomplete_.info() != Eigen::Success)
+    cg_.factorize(jacobian_);
+    if (cg_.preconditioner().info() != Eigen::Success)
       return "the incomplete Cholesky preconditioner could not be computed (is the Jacobian positive definite?)";
     return std::nullopt;
   }
@@ -522,40 +522,14 @@ std::optional<std::string> Solver::solve_newton_system() {
   return std::nullopt;
 }
 
-// J delta = -r from delta = 0 by preconditioned conjugate gradients, stopped
-// on the recurrence's residual. On one thread: Eigen's threaded (row-major)
-// product measured slower on this 2-core machine under load, 30x at 1e4
-// unknowns and 1.2x at 1e6, as OpenBLAS's threads are on small systems.
+// J delta = -r from delta = 0, to cg_tolerance of |r|.
 std::optional<std::string> Solver::conjugate_gradients() {
-  delta_.setZero();
-  cg_residual_ = -r_;
-  const double b2 = cg_residual_.squaredNorm();
-  const double target = std::pow(settings_.cg_tolerance, 2) * b2;
-  if (b2 == 0) return std::nullopt;
-  cg_preconditioned_ = incomplete_.solve(cg_residual_);
-  cg_direction_ = cg_preconditioned_;
-  double rz = cg_residual_.dot(cg_preconditioned_);
-  double r2 = b2;
-  for (int k = 1; k <= settings_.cg_max_iterations; ++k) {
-    ++timings_.linear_iterations;
-    cg_product_.noalias() = jacobian_ * cg_direction_;
-    const double curvature = cg_direction_.dot(cg_product_);
-    if (!(curvature > 0))
-      return fmt::format("the Jacobian is not positive definite (conjugate gradients met p'Jp = {:.3e})", curvature);
-    const double alpha = rz / curvature;
-    delta_ += alpha * cg_direction_;
-    cg_residual_ -= alpha * cg_product_;
-    r2 = cg_residual_.squaredNorm();
-    if (r2 <= target) return std::nullopt;
-    cg_preconditioned_ = incomplete_.solve(cg_residual_);
-    const double rz_next = cg_residual_.dot(cg_preconditioned_);
-    cg_direction_ = cg_preconditioned_ + (rz_next / rz) * cg_direction_;
-    rz = rz_next;
-  }
+  delta_ = cg_.solve(-r_);
+  timings_.linear_iterations += cg_.iterations();
+  if (cg_.info() == Eigen::Success) return std::nullopt;
   return fmt::format("conjugate gradients reached a relative residual of {:.2e} in seepage.cg_max_iterations = {} "
                      "iterations, short of seepage.cg_tolerance = {:.2e}",
-                     std::sqrt(r2 / b2), settings_.cg_max_iterations,
-                     settings_.cg_tolerance);
+                     cg_.error(), settings_.cg_max_iterations, settings_.cg_tolerance);
 }
 
 std::optional<double> Solver::pressure_at(const Eigen::Vector2d& x) const {

@@ -205,11 +205,15 @@ class Solver {
   Eigen::SparseMatrix<double> jacobian_;
   Factorisation factorisation_{};
   Cholmod factor_;
-  // Natural order: on a mesh numbered along its rows it needs fewer conjugate
-  // gradient iterations than AMD's (measured on seepage-benchmark's square:
+  // Eigen's conjugate gradients on the whole (column-major, so
+  // single-threaded: Eigen's threaded product, on row-major matrices,
+  // measured slower on 2 cores, 30x at 1e4 unknowns and 1.2x at 1e6) matrix.
+  // Its incomplete Cholesky factor in natural order: on a mesh numbered along
+  // its rows it needs fewer iterations than AMD's (seepage-benchmark's square:
   // 55 against 87 at 1e5 unknowns, 18 against 27 at 1e4).
-  Eigen::IncompleteCholesky<double, Eigen::Lower, Eigen::NaturalOrdering<int>> incomplete_;
-  Eigen::VectorXd cg_residual_, cg_direction_, cg_preconditioned_, cg_product_;
+  Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper,
+                           Eigen::IncompleteCholesky<double, Eigen::Lower, Eigen::NaturalOrdering<int>>>
+      cg_;
   struct FactorKey {
     double h = -1, a0 = 0;
     long version = -1;
