@@ -427,6 +427,16 @@ def grid_transfer(rows):
     return [line for piece in pieces for line in wrap(piece, 80, bullet=True)]
 
 
+@block("mpm benchmark against earlier builds", "mpm_solid/benchmark/compare-63e0ffd-cd51f91-64cd2b9.csv")
+def mpm_benchmark_builds(rows):
+    """scripts/compare-mpm-benchmark.py's CSV: each build's best throughput and its ratio to the first."""
+    header = list(rows[0].keys())
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    for r in rows:
+        lines.append("| " + " | ".join(r[h] if "[" not in h else sci(float(r[h]), 2) for h in header) + " |")
+    return lines
+
+
 @block("mpm benchmark", "mpm_solid/benchmark/mpm-benchmark.csv")
 def mpm_benchmark(rows):
     materials = ["elastic", "drucker_prager", "elastic_damage"]
