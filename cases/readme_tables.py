@@ -437,6 +437,19 @@ def mpm_benchmark_builds(rows):
     return lines
 
 
+@block("outburst cost", "cases/outburst/benchmark/outburst-benchmark.csv")
+def outburst_cost(rows):
+    """scripts/outburst-benchmark.py's CSV: wall time and the solid's throughput, build against build."""
+    lines = ["| case | build | simulated [s] | wall [s] | solid [s] | MPM particle-steps/s, coupled | "
+             "standalone (mpm-benchmark) | coupled / standalone |", "|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        coupled, alone = float(r["coupled_particle_steps_per_s"]), float(r["standalone_particle_steps_per_s"])
+        lines.append(f"| {r['case'].replace('_', ' ')} | {r['build']} | {float(r['simulated_s']):.3g} | "
+                     f"{float(r['wall_s']):.1f} | {float(r['solid_s']):.1f} | {sci(coupled, 2)} | {sci(alone, 2)} | "
+                     f"{coupled / alone:.2f} |")
+    return lines
+
+
 @block("mpm benchmark", "mpm_solid/benchmark/mpm-benchmark.csv")
 def mpm_benchmark(rows):
     materials = ["elastic", "drucker_prager", "elastic_damage"]

@@ -2,7 +2,7 @@
 # The outburst run until the coal comes to rest: outburst.toml with the tunnel
 # lengthened from 25 m to 100 m (seam_long.msh, seam.geo with tunnel = 100) so
 # the ejected coal stays in the model, run until its kinetic energy is below
-# rest_fraction of its peak (5.8 s, 4 min on 2 cores). Usage:
+# rest_fraction of its peak (about 5.8 s simulated, a few minutes on 2 cores). Usage:
 #   cases/outburst/run-to-rest.sh [RESULTS_DIR]      (default results/outburst_to_rest)
 set -euo pipefail
 cd "$(dirname "$0")/../.."

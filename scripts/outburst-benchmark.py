@@ -1,0 +1,99 @@
+#!/usr/bin/python3
+"""What the outburst costs, build against build: the shipped case's first
+second and its run to rest (cases/outburst/run-to-rest.sh's scene), each
+build in turn, with the wall time, the solid's share of it and its MPM
+throughput (particle-steps per second of solid time, from coupling.csv and
+mpm_history.csv), beside mpm-benchmark's standalone throughput at the same
+particle count, shape and material (B-splines, elastic_damage) and threads.
+
+usage: scripts/outburst-benchmark.py [--threads 2] [--only first_second|to_rest] [--csv FILE] [--out DIR] NAME=BUILD_DIR ...
+  e.g. scripts/outburst-benchmark.py --csv results/outburst-benchmark.csv before=/tmp/old/build after=build
+Run it on an idle machine: two threads that share their cores with other
+work wait on each other at every barrier.
+"""
+import argparse
+import csv
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+sys.path.insert(0, ROOT)
+from cases.effect_cost import particle_steps  # noqa: E402
+
+SCENE = os.path.join(ROOT, "cases", "outburst", "outburst.toml")
+# The run to rest: cases/outburst/run-to-rest.sh's overrides.
+TO_REST = ['scene.end_time="10 s"', 'output.interval="0.1 s"', 'seepage.mesh.file="seam_long.msh"',
+           'mpm.grid.origin=["-75 m", "0 m"]', 'mpm.grid.size=["120 m", "9 m"]',
+           'mpm.obstacles[0].box_min=["-75 m", "0 m"]', 'mpm.obstacles[1].box_min=["-75 m", "6 m"]']
+CASES = {"first_second": [], "to_rest": TO_REST}
+ROW = re.compile(r"^\s*(\d+)\s+bspline\s+elastic_damage\s+([0-9.e+]+)")
+
+
+def standalone(build, particles, threads):
+    out = subprocess.run([os.path.join(build, "mpm_solid", "mpm-benchmark"), str(particles), "--shape", "bspline",
+                          "--material", "elastic_damage", "--threads", str(threads)],
+                         check=True, capture_output=True, text=True).stdout
+    for line in out.splitlines():
+        m = ROW.match(line)
+        if m:
+            return float(m.group(2))
+    sys.exit(f"{build}: mpm-benchmark printed no elastic_damage row (a build older than its --threads option?)")
+
+
+def run(build, case, threads, folder):
+    command = [os.path.join(build, "coupler", "outburst"), SCENE, "-q", "-o", folder, "--overwrite",
+               "-j", str(threads)]
+    for o in CASES[case]:
+        command += ["--set", o]
+    start = time.monotonic()
+    subprocess.run(command, check=True, capture_output=True)
+    wall = time.monotonic() - start
+    with open(os.path.join(folder, "coupling.csv")) as f:
+        windows = list(csv.DictReader(f))
+    solid = sum(float(w["solid_s"]) for w in windows)
+    steps = particle_steps(folder)
+    return {"wall_s": wall, "solid_s": solid, "simulated_s": float(windows[-1]["time"]),
+            "particles": int(windows[0]["particles"]), "coupled_particle_steps_per_s": steps / solid}
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("builds", nargs="+", help="NAME=BUILD_DIR, the first the reference")
+    parser.add_argument("--threads", type=int, default=2)
+    parser.add_argument("--only", choices=sorted(CASES))
+    parser.add_argument("--csv", help="also write the rows here")
+    parser.add_argument("--out", help="keep the runs here, one folder per case and build (for their reports: "
+                                      "python3 -m cases.outburst.report DIR/NAME_CASE)")
+    args = parser.parse_args()
+    builds = []
+    for item in args.builds:
+        name, sep, folder = item.partition("=")
+        if not sep or not os.path.isfile(os.path.join(folder, "coupler", "outburst")):
+            sys.exit(f"{item}: expected NAME=BUILD_DIR with coupler/outburst built in it")
+        builds.append((name, folder))
+    rows = []
+    with tempfile.TemporaryDirectory() as temporary:
+        scratch = args.out or temporary
+        for case in [args.only] if args.only else list(CASES):
+            for name, build in builds:
+                r = run(build, case, args.threads, os.path.join(scratch, f"{name}_{case}"))
+                r["standalone_particle_steps_per_s"] = standalone(build, r["particles"], args.threads)
+                rows.append({"case": case, "build": name, "threads": args.threads} | r)
+                print(f"{case} {name}: {r['wall_s']:.1f} s wall for {r['simulated_s']:.3g} s, solid "
+                      f"{r['solid_s']:.1f} s at {r['coupled_particle_steps_per_s']:.3g} particle-steps/s "
+                      f"(standalone {r['standalone_particle_steps_per_s']:.3g}: "
+                      f"{r['coupled_particle_steps_per_s'] / r['standalone_particle_steps_per_s']:.2f})", flush=True)
+    if args.csv:
+        with open(args.csv, "w", newline="") as f:
+            w = csv.DictWriter(f, fieldnames=list(rows[0]))
+            w.writeheader()
+            w.writerows(rows)
+
+
+if __name__ == "__main__":
+    main()
