@@ -15,6 +15,8 @@ import re
 import subprocess
 import sys
 
+from builds import named_builds  # scripts/builds.py
+
 ROW = re.compile(r"^\s*(\d+)\s+(\S+)\s+(\S+)\s+([0-9.e+]+)")
 
 
@@ -39,12 +41,7 @@ def main():
     parser.add_argument("--rounds", type=int, default=5)
     parser.add_argument("--csv", help="also write the table here")
     args = parser.parse_args()
-    builds = []
-    for item in args.builds:
-        name, sep, folder = item.partition("=")
-        if not sep or not os.path.isfile(os.path.join(folder, "mpm_solid", "mpm-benchmark")):
-            sys.exit(f"{item}: expected NAME=BUILD_DIR with mpm_solid/mpm-benchmark built in it")
-        builds.append((name, folder))
+    builds = named_builds(args.builds, os.path.join("mpm_solid", "mpm-benchmark"))
     best = {name: {} for name, _ in builds}
     for r in range(args.rounds):
         for name, folder in builds:

@@ -24,6 +24,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, ROOT)
 from cases.effect_cost import particle_steps  # noqa: E402
+from builds import named_builds  # noqa: E402 (scripts/builds.py)
 
 SCENE = os.path.join(ROOT, "cases", "outburst", "outburst.toml")
 # The run to rest: cases/outburst/run-to-rest.sh's overrides.
@@ -70,12 +71,7 @@ def main():
     parser.add_argument("--out", help="keep the runs here, one folder per case and build (for their reports: "
                                       "python3 -m cases.outburst.report DIR/NAME_CASE)")
     args = parser.parse_args()
-    builds = []
-    for item in args.builds:
-        name, sep, folder = item.partition("=")
-        if not sep or not os.path.isfile(os.path.join(folder, "coupler", "outburst")):
-            sys.exit(f"{item}: expected NAME=BUILD_DIR with coupler/outburst built in it")
-        builds.append((name, folder))
+    builds = named_builds(args.builds, os.path.join("coupler", "outburst"))
     rows = []
     with tempfile.TemporaryDirectory() as temporary:
         scratch = args.out or temporary
