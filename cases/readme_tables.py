@@ -569,6 +569,40 @@ def outburst_convergence_ensemble_grains(rows):
     return ensemble_block(rows)
 
 
+STEP_STUDY = ["convergence.csv", "convergence_courant0.19.csv", "convergence_courant0.1.csv",
+              "convergence_pic_per_time.csv", "convergence_ensemble.csv", "convergence_ensemble_courant0.219.csv"]
+
+
+@block("outburst convergence and the time step", *[f"cases/outburst/convergence/{f}" for f in STEP_STUDY])
+def outburst_step_study(*sources):
+    """The crack band's runs at 0.5 s by Courant number and PIC share: uniform coal, and heterogeneous coal
+    (m = 3) as the mean +- the 95 % interval over its seeds."""
+    from .outburst.convergence import QUANTITIES
+    from .outburst.ensemble import summary
+    shown = [q for q in QUANTITIES if not q[0].startswith("cavity")]
+    lines = ["| Courant | PIC share per step | PIC share per cell transit (share / Courant) | coal | cell | " +
+             " | ".join(label for _, label in shown) + " |", "|---|---|---|---|---|" + "---|" * len(shown)]
+    for rows in sources:
+        rows = [r for r in rows if r["law"] == "crack_band" and not r.get("failure") and float(r["time_s"]) == 0.5]
+        for cell in dict.fromkeys(r["cell"] for r in rows):
+            mine = [r for r in rows if r["cell"] == cell]
+            given = dict(item.split("=", 1) for item in mine[0].get("settings", "").split())
+            courant = float(given.get("mpm.courant", 0.3))
+            pic = 1 - float(given.get("mpm.flip_fraction", 0.99))
+            if mine[0].get("seed"):
+                coal = f"m = {float(mine[0]['homogeneity']):g}, {len(mine)} seeds"
+                values = []
+                for key, _ in shown:
+                    mean, _, half = summary([float(r[key]) for r in mine])
+                    values.append(f"{mean:.3g} +- {half:.2g}")
+            else:
+                coal = "uniform"
+                values = [f"{float(mine[0][key]):.3g}" for key, _ in shown]
+            lines.append(f"| {courant:g} | {pic:.3g} | {pic / courant:.3g} | {coal} | {cell} | " + " | ".join(values) +
+                         " |")
+    return lines
+
+
 @block("outburst fracture sensitivity", "cases/outburst/convergence/sensitivity.csv")
 def outburst_fracture_sensitivity(rows):
     from .outburst.sensitivity import table

@@ -227,7 +227,8 @@ def main():
             name = f"{law}_{cell.numerator}_{cell.denominator}"
             overrides = [f'scene.end_time="{args.end_time}"', f'mpm.grid.cell_size="{float(cell)!r} m"',
                          f'seepage.mesh.file="{seam_mesh(args.out, cell, f"seam_{cell.numerator}_{cell.denominator}.msh")}"', 'output.interval="0.1 s"'] + args.set
-            row = {"law": law, "cell": label}
+            # The overrides given with --set, so the CSV says what the run was.
+            row = {"law": law, "cell": label} | ({"settings": " ".join(args.set)} if args.set else {})
             if not args.seeds:
                 run_dir = os.path.join(args.out, name)
                 rows += measured(kept_or_run(args, law, scene, overrides, run_dir, label, args.threads or cores), run_dir, row,
