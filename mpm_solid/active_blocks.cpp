@@ -50,7 +50,11 @@ void ActiveBlocks::collect() {
     for (int bx = 0; bx < blocks_[0]; ++bx) {
       if (!active_[static_cast<std::size_t>((j / size) * blocks_[0] + bx)]) continue;
       const int from = bx * size, count = std::min(nodes_[0], from + size) - from;
-      if (!runs_.empty() && runs_.back().first + static_cast<std::size_t>(runs_.back().count) == row + from)
+      // Runs stay within a row: merged across rows, a body as wide as the
+      // grid would make one run of every node, and the passes, parallel
+      // over runs, one thread's work.
+      if (from > 0 && !runs_.empty() &&
+          runs_.back().first + static_cast<std::size_t>(runs_.back().count) == row + from)
         runs_.back().count += count;
       else
         runs_.push_back({row + static_cast<std::size_t>(from), count});

@@ -315,7 +315,8 @@ void Solver::scatter_mass_momentum() {
   clear_grid();
   Scatter<double> masses{thread_mass_, mass_, active_.runs()};
   Scatter<Vec<2>> momenta{thread_vector_, momentum_, active_.runs()};
-#pragma omp parallel num_threads(threads_)
+  long outside = 0;
+#pragma omp parallel num_threads(threads_) reduction(+ : outside)
   {
     double* m = masses.buffer(omp_get_thread_num()).data();
     Vec<2>* mv = momenta.buffer(omp_get_thread_num()).data();
@@ -325,7 +326,12 @@ void Solver::scatter_mass_momentum() {
     Stencil2<Shape> s;
 #pragma omp for schedule(static)
     for (int i = 0; i < n; ++i) {
-      s.template compute<Apic>(lattice, p.x[i], p.half_width[i]);
+      // Particles leave the grid at the end of a step; one beyond its ghost
+      // nodes here came from outside (a solver built with it there).
+      if (!s.template compute<Apic>(lattice, p.x[i], p.half_width[i])) {
+        ++outside;
+        continue;
+      }
       ActiveBlocks::set_reached<Shape::support>(reached, blocks_along_x, s.base);
       // Read once: the compiler cannot tell the nodal sums from the
       // particle's fields, and would load these again after every store.
@@ -342,9 +348,26 @@ void Solver::scatter_mass_momentum() {
     }
   }
   active_.collect();
+  if (outside > 0)
+    throw SimulationError(fmt::format("mpm: step {}: {} particles lie beyond the grid's ghost nodes", steps_ + 1,
+                                      outside));
   masses.gather();
   momenta.gather();
   fold_ghosts(&mass_, momentum_);
+}
+
+std::size_t Solver::stray_nodal_values() const {
+  std::vector<char> active(mass_.size(), 0);
+  for (const auto& r : active_.runs()) std::fill_n(active.begin() + static_cast<std::ptrdiff_t>(r.first), r.count, 1);
+  std::size_t stray = 0;
+  for (std::size_t i = 0; i < mass_.size(); ++i) {
+    if (!active[i])
+      stray += (mass_[i] != 0) + (momentum_[i] != Vec<2>::Zero()) + (force_[i] != Vec<2>::Zero()) +
+               (velocity_[i] != Vec<2>::Zero()) + (velocity_new_[i] != Vec<2>::Zero());
+    for (const auto& t : thread_mass_) stray += t[i] != 0;
+    for (const auto& t : thread_vector_) stray += t[i] != Vec<2>::Zero();
+  }
+  return stray;
 }
 
 void Solver::clear_grid() {

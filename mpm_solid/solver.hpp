@@ -279,6 +279,10 @@ class Solver {
 
   // The grid nodes the last step's passes ran over (ActiveBlocks).
   std::size_t active_nodes() const { return active_.active_nodes(); }
+  // Nonzero nodal values outside those nodes, and in the threads' scatter
+  // buffers anywhere: none between steps, the invariant the grid's passes
+  // rely on (checked by the tests).
+  std::size_t stray_nodal_values() const;
 
   // Memory held now [bytes]: by the particles (every field, and the per-step
   // arrays sized by them) and by the grid (the nodal arrays, one set per thread).

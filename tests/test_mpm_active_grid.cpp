@@ -12,6 +12,13 @@ using namespace outburst::testing;
 
 namespace {
 
+// The OpenMP thread count for a scope (a solver takes it when built).
+struct ThreadsFor {
+  int before = omp_get_max_threads();
+  explicit ThreadsFor(int n) { omp_set_num_threads(n); }
+  ~ThreadsFor() { omp_set_num_threads(before); }
+};
+
 struct Run {
   Particles<2> particles;
   Energies energies;
@@ -43,8 +50,7 @@ TEST_CASE("a body on a wider, empty grid moves bit for bit as on a narrow one, o
   const Scheme scheme = GENERATE(Scheme::usf, Scheme::musl);
   // One thread: with more, a wider grid shares its runs of nodes out
   // differently and the sums round differently.
-  const int threads = omp_get_max_threads();
-  omp_set_num_threads(1);
+  const ThreadsFor one(1);
   const Run narrow = drop(4.0, shape, scheme), wide = drop(16.0, shape, scheme);
   REQUIRE(narrow.particles.size() == wide.particles.size());
   for (std::size_t i = 0; i < narrow.particles.size(); ++i) {
@@ -58,5 +64,33 @@ TEST_CASE("a body on a wider, empty grid moves bit for bit as on a narrow one, o
                        << " of " << wide.grid_nodes);
   CHECK(wide.active_nodes == narrow.active_nodes);
   CHECK(wide.active_nodes < wide.grid_nodes / 3);
-  omp_set_num_threads(threads);
+}
+
+TEST_CASE("between steps every nodal value outside the active blocks is zero, on two threads, whatever the walls",
+          "[mpm][active grid]") {
+  const Scheme scheme = GENERATE(Scheme::usf, Scheme::usl, Scheme::musl);
+  const ShapeKind shape = GENERATE(ShapeKind::linear, ShapeKind::bspline);
+  const Wall::Type left = GENERATE(Wall::Type::fixed, Wall::Type::roller, Wall::Type::friction, Wall::Type::open);
+  const ThreadsFor two(2);
+  // A thin domain (its walls' strips span blocks), 61 cells wide (no whole
+  // number of blocks), a body thrown left along the floor into the left wall,
+  // over a rigid step and under a platen pushing down on its top.
+  const Grid<2> g = grid(6.1, 0.7, 0.1);
+  Particles<2> p = block(g, Vec<2>(0.3, 0.0), Vec<2>(2.3, 0.5), 1000, 2);
+  for (auto& v : p.v) v = Vec<2>(-1.0, 0.2);
+  Settings s;
+  s.scheme = scheme;
+  s.shape = shape;
+  s.gravity = {0, -9.81};
+  s.smooth_dilatation = scheme == Scheme::usl;
+  s.walls = {Wall{left, 0.3}, Wall{Wall::Type::roller}, Wall{Wall::Type::fixed}, Wall{Wall::Type::roller}};
+  s.obstacles.push_back({Vec<2>(4.0, 0.0), Vec<2>(4.5, 0.2), Wall{Wall::Type::friction, 0.4}, false});
+  s.platens.push_back({Vec<2>(0.0, 0.5), Vec<2>(1.0, 0.6), 1, -1e3, std::nullopt});
+  Solver solver(g, elastic({1000, 1e7, 0.3}), std::move(p), s);
+  for (int k = 0; k < 200; ++k) {
+    solver.step(solver.stable_time_step());
+    INFO("step " << k + 1);
+    REQUIRE(solver.stray_nodal_values() == 0);
+  }
+  CHECK(solver.active_nodes() < g.num_nodes());
 }
