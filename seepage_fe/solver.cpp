@@ -527,9 +527,12 @@ std::optional<std::string> Solver::conjugate_gradients() {
   delta_ = cg_.solve(-r_);
   timings_.linear_iterations += cg_.iterations();
   if (cg_.info() == Eigen::Success) return std::nullopt;
-  return fmt::format("conjugate gradients reached a relative residual of {:.2e} in seepage.cg_max_iterations = {} "
-                     "iterations, short of seepage.cg_tolerance = {:.2e}",
-                     cg_.error(), settings_.cg_max_iterations, settings_.cg_tolerance);
+  if (!std::isfinite(cg_.error()))
+    return fmt::format("conjugate gradients broke down after {} iterations (is the Jacobian positive definite?)",
+                       cg_.iterations());
+  return fmt::format("conjugate gradients reached a relative residual of {:.2e} in {} iterations "
+                     "(seepage.cg_max_iterations = {}), short of seepage.cg_tolerance = {:.2e}",
+                     cg_.error(), cg_.iterations(), settings_.cg_max_iterations, settings_.cg_tolerance);
 }
 
 std::optional<double> Solver::pressure_at(const Eigen::Vector2d& x) const {

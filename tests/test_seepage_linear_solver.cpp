@@ -120,7 +120,8 @@ TEST_CASE("every CHOLMOD mode and ordering solves the seepage Jacobian", "[seepa
       INFO(f.name());
       REQUIRE(factor.info() == Eigen::Success);
       CHECK((factor.solve(b) - x).lpNorm<Eigen::Infinity>() < 1e-12);
-      // The ordering CHOLMOD used, and its mode, are the ones asked for.
+      // configure() asked CHOLMOD for the ordering and mode named (by
+      // default CHOLMOD itself picks AMD or METIS).
       const cholmod_common& c = factor.cholmod();
       const int used = c.method[c.selected].ordering;
       if (ordering == F::Ordering::cholmod_default)
