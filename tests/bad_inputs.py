@@ -77,6 +77,11 @@ def main():
     names = [c["name"] for c in cases]
     if len(set(names)) != len(names):
         sys.exit("the catalogue names a case twice")
+    # A case that runs writes its output: into its own folder, not the
+    # source tree's results/, where a second run of the suite finds it.
+    unplaced = [c["name"] for c in cases if c.get("run") and "-o" not in c.get("args", [])]
+    if unplaced:
+        sys.exit(f"cases that run without -o (give args = [\"-o\", \"DIR\"]): {', '.join(unplaced)}")
     failed = 0
     with concurrent.futures.ThreadPoolExecutor(max_workers=os.cpu_count() or 1) as pool:
         for case, code, output, problems in pool.map(lambda c: run_case(c, build, source, work), cases):
