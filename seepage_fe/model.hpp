@@ -58,7 +58,7 @@ struct Model {
 
 enum class TimeScheme { backward_euler, bdf2 };
 enum class NonlinearMethod { newton, picard };
-enum class LinearSolver { direct, cg };
+enum class LinearSolver { direct, cg, lagged };
 
 struct Settings {
   TimeScheme scheme = TimeScheme::bdf2;
@@ -66,11 +66,15 @@ struct Settings {
   double tolerance = 1e-10;  // on the relative update max|du| / max|u|
   int max_iterations = 30;
   int max_step_cuts = 12;    // halvings of a failing step before giving up
-  // The Newton systems: CHOLMOD, or conjugate gradients preconditioned by an
-  // incomplete Cholesky factor, solved to ||J du + r|| <= cg_tolerance ||r||.
+  // The Newton systems: CHOLMOD; conjugate gradients preconditioned by an
+  // incomplete Cholesky factor; or (lagged) conjugate gradients preconditioned
+  // by CHOLMOD's factor of an earlier Jacobian, renewed when they need more than
+  // lag_max_iterations. Both iterative ones solve to
+  // ||J du + r|| <= cg_tolerance ||r||.
   LinearSolver linear_solver = LinearSolver::direct;
   double cg_tolerance = 1e-8;
   int cg_max_iterations = 5000;  // beyond them the step is cut
+  int lag_max_iterations = 10;
 };
 
 }  // namespace outburst::seepage

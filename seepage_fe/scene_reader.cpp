@@ -120,21 +120,32 @@ void read_settings(const scene::Table& s, Setup& setup) {
       {"max_step_cuts", "halvings of a failing step before the run stops", "12", Range::between(0, 60)});
   st.linear_solver = s.choice<LinearSolver>(
       {"linear_solver",
-       "the Newton systems: \"direct\" (CHOLMOD, its mode and ordering picked by size) or \"cg\" (conjugate "
-       "gradients with an incomplete Cholesky preconditioner)",
+       "the Newton systems: \"direct\" (CHOLMOD, its mode and ordering picked by size), \"cg\" (conjugate "
+       "gradients with an incomplete Cholesky preconditioner) or \"lagged\" (conjugate gradients preconditioned "
+       "by CHOLMOD's factor of an earlier Jacobian)",
        "direct"},
-      {{"direct", LinearSolver::direct}, {"cg", LinearSolver::cg}});
-  if (st.linear_solver == LinearSolver::cg) {
+      {{"direct", LinearSolver::direct}, {"cg", LinearSolver::cg}, {"lagged", LinearSolver::lagged}});
+  const bool iterative = st.linear_solver != LinearSolver::direct;
+  if (iterative)
     st.cg_tolerance = s.number({"cg_tolerance", "conjugate gradients stop at ||J du + r|| <= cg_tolerance ||r||",
                                 "1e-8", Range{0.0, 1.0, false, false}});
+  else if (s.has("cg_tolerance"))
+    s.fail("cg_tolerance", "applies to conjugate gradients only: set seepage.linear_solver = \"cg\" or \"lagged\"");
+  if (st.linear_solver == LinearSolver::cg)
     st.cg_max_iterations = s.integer<int>({"cg_max_iterations",
                                            "conjugate gradient iterations before the step is cut and retried",
                                            "5000", Range::between(1, 1e7)});
-  } else {
-    for (const char* key : {"cg_tolerance", "cg_max_iterations"})
-      if (s.has(key)) s.fail(key, "applies to conjugate gradients only: set seepage.linear_solver = \"cg\"");
-  }
-
+  else if (s.has("cg_max_iterations"))
+    s.fail("cg_max_iterations", "applies to incomplete-Cholesky conjugate gradients only: set "
+                                "seepage.linear_solver = \"cg\"");
+  if (st.linear_solver == LinearSolver::lagged)
+    st.lag_max_iterations = s.integer<int>(
+        {"lag_max_iterations",
+         "conjugate gradient iterations on an earlier Jacobian's factor before it is renewed (a renewal "
+         "costs about as many triangular solves as the factorisation's flops over the solve's)",
+         "10", Range::between(1, 1000)});
+  else if (s.has("lag_max_iterations"))
+    s.fail("lag_max_iterations", "applies to the lagged factorisation only: set seepage.linear_solver = \"lagged\"");
 }
 
 // The step sizes of a run of its own (a coupled run's window sets them).

@@ -164,7 +164,7 @@ void Solver::setup_system() {
   jacobian_ = stiffness_;
   assemble_conductivity();
   blas::set_threads_for(static_cast<long>(n));
-  if (settings_.linear_solver == LinearSolver::direct) {
+  if (settings_.linear_solver != LinearSolver::cg) {
     factorisation_ = factorisation_for(n);
     configure(factor_, factorisation_);
     factor_.analyzePattern(jacobian_);
@@ -172,6 +172,11 @@ void Solver::setup_system() {
     cg_.setTolerance(settings_.cg_tolerance);
     cg_.setMaxIterations(settings_.cg_max_iterations);
     cg_.analyzePattern(jacobian_);
+  }
+  if (settings_.linear_solver == LinearSolver::lagged) {
+    lagged_cg_.setTolerance(settings_.cg_tolerance);
+    lagged_cg_.setMaxIterations(settings_.lag_max_iterations);
+    lagged_cg_.preconditioner().use(&factor_);
   }
   const std::size_t size = n;
   for (auto* v : {&trial_, &history_, &load_, &r_, &delta_, &candidate_})
@@ -377,26 +382,12 @@ std::optional<std::string> Solver::try_step(double h, int& iterations) {
   set_boundary_values(t_new, trial_);
 
   double norm = residual(trial_, a0, h);
-  const bool linear = law == Law::linear;
   // The update criterion needs one more iteration to confirm convergence; a
   // residual this small relative to its terms needs none.
   const double residual_tolerance = 1e-2 * settings_.tolerance;
   for (iterations = 1; iterations <= settings_.max_iterations; ++iterations) {
     ++timings_.nonlinear_iterations;
-    // A linear law's Jacobian depends only on h, a0 and k: keep its factorisation.
-    const bool reuse = linear && factor_key_.h == h && factor_key_.a0 == a0 &&
-                       factor_key_.version == conductivity_version_;
-    if (!reuse) {
-      build_jacobian(trial_, a0, h);
-      if (auto failure = factorise()) {
-        factor_key_ = {};
-        return failure;
-      }
-      factor_key_ = linear ? FactorKey{h, a0, conductivity_version_} : FactorKey{};
-    }
-    for (Eigen::Index i = 0; i < r_.size(); ++i)
-      if (fixed_by_[i] >= 0) r_[i] = 0;
-    if (auto failure = solve_newton_system()) return failure;
+    if (auto failure = newton_direction(trial_, a0, h)) return failure;
     if (!delta_.allFinite()) return "the Newton update is not finite";
 
     // Keep the gas law's P positive: never step more than 90% of the way to zero.
@@ -499,6 +490,47 @@ StepReport Solver::advance(double dt) {
     h *= 0.5;
   }
   return report;
+}
+
+std::optional<std::string> Solver::newton_direction(const Eigen::VectorXd& u, double a0, double h) {
+  for (Eigen::Index i = 0; i < r_.size(); ++i)
+    if (fixed_by_[i] >= 0) r_[i] = 0;
+  const FactorKey key{h, a0, conductivity_version_};
+  // A linear law's Jacobian depends only on h, a0 and k: keep its
+  // factorisation (the lagged solver too: its iterations would converge in one).
+  if (model_.law == Law::linear) {
+    if (factor_key_.h != h || factor_key_.a0 != a0 || factor_key_.version != conductivity_version_) {
+      build_jacobian(u, a0, h);
+      if (auto failure = factorise()) {
+        factor_key_ = {};
+        return failure;
+      }
+      factor_key_ = key;
+    }
+    return solve_newton_system();
+  }
+  build_jacobian(u, a0, h);
+  if (settings_.linear_solver == LinearSolver::lagged && factor_key_.h == h &&
+      factor_key_.version == conductivity_version_ && lagged_conjugate_gradients())
+    return std::nullopt;
+  if (auto failure = factorise()) {
+    factor_key_ = {};
+    return failure;
+  }
+  if (settings_.linear_solver == LinearSolver::lagged) factor_key_ = key;
+  return solve_newton_system();
+}
+
+bool Solver::lagged_conjugate_gradients() {
+  ScopedTimer timer(timings_.solve);
+  lagged_cg_.compute(jacobian_);
+  delta_ = lagged_cg_.solve(-r_);
+  timings_.linear_iterations += lagged_cg_.iterations();
+  if (lagged_cg_.info() != Eigen::Success || !delta_.allFinite()) return false;
+  // Half the allowance spent: the next iteration renews the factor rather than
+  // spend as much again.
+  if (2 * lagged_cg_.iterations() > settings_.lag_max_iterations) factor_key_ = {};
+  return true;
 }
 
 std::optional<std::string> Solver::factorise() {

@@ -3,7 +3,8 @@
 // variable-step BDF2 in time, Newton (with a line search) or Picard for the
 // nonlinear storage, CHOLMOD for the linear systems with the symbolic
 // factorisation computed once (or, as Settings::linear_solver asks,
-// conjugate gradients with an incomplete Cholesky preconditioner).
+// conjugate gradients with an incomplete Cholesky preconditioner, or with
+// CHOLMOD's factor of an earlier Jacobian).
 //
 // Public face, in the order a driver uses it:
 //   Solver s(mesh, model, settings);
@@ -75,13 +76,33 @@ using Cholmod = Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::
 // Sets the mode and ordering, before analyzePattern.
 void configure(Cholmod& factor, Factorisation f);
 
+// A CHOLMOD factor computed elsewhere as the preconditioner of Eigen's
+// conjugate gradients: compute() and factorize() leave it as it is, so it may
+// be the factor of an earlier matrix (the lagged linear solver's).
+class FactorPreconditioner {
+ public:
+  template <typename Matrix>
+  FactorPreconditioner& analyzePattern(const Matrix&) { return *this; }
+  template <typename Matrix>
+  FactorPreconditioner& factorize(const Matrix&) { return *this; }
+  template <typename Matrix>
+  FactorPreconditioner& compute(const Matrix&) { return *this; }
+  void use(const Cholmod* factor) { factor_ = factor; }
+  template <typename Rhs>
+  Eigen::VectorXd solve(const Rhs& b) const { return factor_->solve(b); }
+  Eigen::ComputationInfo info() const { return Eigen::Success; }
+
+ private:
+  const Cholmod* factor_ = nullptr;
+};
+
 // Wall time spent in each part of the solver [s], for benchmarks and studies.
 struct Timings {
   double assembly = 0;       // conductivity matrix
   double residual = 0;       // residual evaluations, including line search trials
   double jacobian = 0;       // building the Jacobian values
   double factorization = 0;  // CHOLMOD numeric factorisation, or the incomplete Cholesky factor
-  double solve = 0;          // triangular solves, or the conjugate gradient iterations
+  double solve = 0;          // triangular solves, or the conjugate gradient iterations (lagged: on the factor)
   double total_step = 0;     // everything inside advance()
   long factorizations = 0;
   long nonlinear_iterations = 0;
@@ -159,6 +180,9 @@ class Solver {
   const Factorisation& factorisation() const { return factorisation_; }
   // The current Jacobian (for benchmarks that time a bare factorisation of it).
   const Eigen::SparseMatrix<double>& jacobian() const { return jacobian_; }
+  // The next Newton iteration factorises afresh (benchmarks time runs of the
+  // lagged solver from their first factorisation).
+  void drop_factorisation() { factor_key_ = {}; }
 
  private:
   void setup_system();
@@ -170,11 +194,17 @@ class Solver {
   void build_jacobian(const Eigen::VectorXd& u, double a0, double h);
   // One attempt at a step of size h; on failure returns the reason.
   std::optional<std::string> try_step(double h, int& iterations);
+  // delta_ = -J^-1 r_ for the Jacobian at u, built and factorised as the
+  // linear solver needs; on failure the reason.
+  std::optional<std::string> newton_direction(const Eigen::VectorXd& u, double a0, double h);
   // Factorises jacobian_ (CHOLMOD or incomplete Cholesky); on failure the reason.
   std::optional<std::string> factorise();
-  // delta_ = -J^-1 r_; on failure the reason.
+  // delta_ = -J^-1 r_ by the factorisation (or cg_'s iterations) of jacobian_.
   std::optional<std::string> solve_newton_system();
   std::optional<std::string> conjugate_gradients();
+  // delta_ by conjugate gradients preconditioned by factor_ (of an earlier
+  // Jacobian); false when they need more than lag_max_iterations.
+  bool lagged_conjugate_gradients();
   void accept_step(double h, double a0, double a2);
 
   Mesh mesh_;
@@ -214,6 +244,10 @@ class Solver {
   Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper,
                            Eigen::IncompleteCholesky<double, Eigen::Lower, Eigen::NaturalOrdering<int>>>
       cg_;
+  // The lagged solver's iterations on factor_ while jacobian_ moves on.
+  Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper, FactorPreconditioner> lagged_cg_;
+  // What factor_ was computed for. The Jacobian is h K + diag(a0 c S'(u)):
+  // with h and K (its version) kept, only the diagonal has moved since.
   struct FactorKey {
     double h = -1, a0 = 0;
     long version = -1;

@@ -1,7 +1,7 @@
 """Time per Newton iteration of our seepage solver against FEniCSx on the same problem.
 
 usage: /usr/bin/python3 seepage_fe/benchmark/compare_fenicsx.py [--build build] [--cells 315 999]
-           [--rounds 3] [--steps 3] [--threads 2] [--csv FILE]
+           [--rounds 3] [--steps 3] [--threads 2] [--loose-tolerance 1e-4] [--csv FILE]
 
 The problem is seepage-benchmark's: the unit square in n x n Q1 quadrilaterals, the gas law
 d/dt(A P^(1/4)) = div(lambda grad P) with A = 2, lambda = 0.1, P = 9 at t = 0 and P = 1 on
@@ -10,11 +10,14 @@ an update of 1e-10 of P. FEniCSx (0.5, Debian's python3-dolfinx) writes it in UF
 storage integrated at the cell corners (Gauss-Lobatto, degree 1: the lumped storage) and
 solves it with its NewtonSolver and MUMPS LU, as its users would; it runs as one process
 with `--threads` OpenBLAS threads and as `--threads` MPI processes, and the faster of the
-two is the reference. Ours runs seepage-benchmark (direct and cg) with `--threads`
-threads. Each timed step is a whole Newton solve (assemblies, factorisations, solves),
-divided by its iterations; the mesh, the forms' compilation and a first step are not
-timed. Rounds alternate ours and theirs and each keeps its best round, since the machine
-may be shared.
+two is the reference. Ours runs seepage-benchmark with `--threads` threads under each of
+its linear solvers (direct, cg and lagged at seepage.cg_tolerance's default, and lagged at
+`--loose-tolerance`), each a run of `--steps` steps from the state after a first step, the
+first of them factorising afresh; each row says how far its solution lies from the direct
+one's (max |u - u_direct| / max |u_direct|). Each timed step is a whole Newton solve
+(assemblies, factorisations, solves), divided by its iterations: FEniCSx's best step, our
+run's mean; the mesh, the forms' compilation and a first step are not timed. Rounds
+alternate ours and theirs and each keeps its best round, since the machine may be shared.
 
 Without dolfinx it says so and exits 0: this is a benchmark, not a test.
 """
@@ -104,18 +107,27 @@ def fenicsx(cells, steps, processes, threads):
     return run_json(command, env)
 
 
-def ours(build, cells, steps, threads):
-    """{"direct": row, "cg": row} of seepage-benchmark's Newton CSV."""
+def ours(build, cells, steps, threads, loose_tolerance):
+    """{contender: seepage-benchmark's Newton row} for each of our linear solvers."""
+    runs = ((("direct", "cg", "lagged"), None, ""), (("direct", "lagged"), loose_tolerance, f", cg_tolerance {loose_tolerance:g}"))
+    rows = {}
     with tempfile.TemporaryDirectory() as tmp:
         path = os.path.join(tmp, "newton.csv")
-        command = [os.path.join(build, "seepage_fe", "seepage-benchmark"), str(cells), "--no-orderings",
-                   "--rounds", str(steps), "--time-step", str(TIME_STEP), "--csv", path]
-        env = dict(os.environ, OMP_NUM_THREADS=str(threads))
-        out = subprocess.run(command, env=env, capture_output=True, text=True)
-        if out.returncode != 0:
-            sys.exit(f"{' '.join(command)} failed ({out.returncode}):\n{out.stderr}")
-        with open(path, newline="") as f:
-            return {r["linear_solver"]: r for r in csv.DictReader(f)}
+        for solvers, tolerance, suffix in runs:
+            command = [os.path.join(build, "seepage_fe", "seepage-benchmark"), str(cells), "--no-orderings",
+                       "--rounds", "1", "--steps", str(steps), "--time-step", str(TIME_STEP), "--csv", path,
+                       "--linear-solvers", *solvers]
+            if tolerance is not None:
+                command += ["--cg-tolerance", str(tolerance)]
+            env = dict(os.environ, OMP_NUM_THREADS=str(threads))
+            out = subprocess.run(command, env=env, capture_output=True, text=True)
+            if out.returncode != 0:
+                sys.exit(f"{' '.join(command)} failed ({out.returncode}):\n{out.stderr}")
+            with open(path, newline="") as f:
+                for r in csv.DictReader(f):
+                    if r["linear_solver"] in solvers[1:] or not suffix:
+                        rows[f"ours, {r['linear_solver']}{suffix}"] = r
+    return rows
 
 
 def main(argv=None):
@@ -126,12 +138,17 @@ def main(argv=None):
                         help="cells per side (unknowns (n + 1)^2; default about 1e5 and 1e6)")
     parser.add_argument("--rounds", type=int, default=3)
     parser.add_argument("--steps", type=int, default=3, help="timed steps per run, after one untimed")
+    parser.add_argument("--loose-tolerance", type=float, default=1e-4,
+                        help="seepage.cg_tolerance of the second lagged row (the Newton iterations still stop at "
+                             "the same nonlinear tolerance; the rows say how far the solution moves)")
     parser.add_argument("--threads", type=int, default=2)
     parser.add_argument("--csv", help="write the table to this CSV (seepage_fe/benchmark/fenicsx.csv is one)")
     args = parser.parse_args(argv)
     for name, value in (("--rounds", args.rounds), ("--steps", args.steps), ("--threads", args.threads)):
         if value < 1:
             parser.error(f"{name} must be at least 1, got {value}")
+    if not 0 < args.loose_tolerance < 1:
+        parser.error(f"--loose-tolerance must lie in (0, 1), got {args.loose_tolerance}")
     if any(n < 2 for n in args.cells):
         parser.error("--cells: each must be at least 2")
     if args.worker is not None:
@@ -145,36 +162,40 @@ def main(argv=None):
     if not os.access(os.path.join(args.build, "seepage_fe", "seepage-benchmark"), os.X_OK):
         sys.exit(f"compare_fenicsx: no {args.build}/seepage_fe/seepage-benchmark: build first (scripts/build.sh)")
 
-    contenders = ["ours, direct", "ours, cg", "FEniCSx, 1 process", f"FEniCSx, {args.threads} processes"]
+    mine_names = ["ours, direct", "ours, cg", "ours, lagged", f"ours, lagged, cg_tolerance {args.loose_tolerance:g}"]
+    fenicsx_names = ["FEniCSx, 1 process", f"FEniCSx, {args.threads} processes"]
+    contenders = mine_names + fenicsx_names
     rows = []
     print(f"FEniCSx {dolfinx.__version__}; {args.rounds} rounds of {args.steps} steps, best kept; "
           f"{args.threads} threads")
     for cells in args.cells:
         best = {c: None for c in contenders}
 
-        def keep(name, time, iterations):
+        def keep(name, time, iterations, difference=""):
             if best[name] is None or time < best[name][0]:
-                best[name] = (time, iterations)
+                best[name] = (time, iterations, difference)
 
         for r in range(args.rounds):
-            mine = ours(args.build, cells, args.steps, args.threads)
-            keep("ours, direct", float(mine["direct"]["newton_iteration_s"]),
-                 float(mine["direct"]["newton_iterations"]))
-            keep("ours, cg", float(mine["cg"]["newton_iteration_s"]), float(mine["cg"]["newton_iterations"]))
-            for processes, name in ((1, contenders[2]), (args.threads, contenders[3])):
+            mine = ours(args.build, cells, args.steps, args.threads, args.loose_tolerance)
+            for name in mine_names:
+                row = mine[name]
+                keep(name, float(row["newton_iteration_s"]), float(row["newton_iterations"]) / args.steps,
+                     row["difference"])
+            for processes, name in ((1, fenicsx_names[0]), (args.threads, fenicsx_names[1])):
                 theirs = fenicsx(cells, args.steps, processes, args.threads if processes == 1 else 1)
                 keep(name, theirs["newton_iteration_s"], theirs["newton_iterations"])
             print(f"  {(cells + 1) ** 2} unknowns, round {r + 1}: "
                   + ", ".join(f"{c} {best[c][0]:.4f} s" for c in contenders), flush=True)
-        reference = min(best[c][0] for c in contenders[2:])
+        reference = min(best[c][0] for c in fenicsx_names)
         for c in contenders:
             rows.append({"unknowns": (cells + 1) ** 2, "contender": c, "threads": args.threads,
                          "newton_iteration_s": f"{best[c][0]:.6g}", "newton_iterations": f"{best[c][1]:.3g}",
-                         "fenicsx_over_this": f"{reference / best[c][0]:.3f}"})
-    print(f"\n{'unknowns':>9} {'contender':<22} {'per Newton it. [s]':>18} {'its/step':>8} {'FEniCSx/this':>12}")
+                         "fenicsx_over_this": f"{reference / best[c][0]:.3f}", "difference": best[c][2]})
+    print(f"\n{'unknowns':>9} {'contender':<36} {'per Newton it. [s]':>18} {'its/step':>8} {'FEniCSx/this':>12} "
+          f"{'differs':>9}")
     for r in rows:
-        print(f"{r['unknowns']:>9} {r['contender']:<22} {float(r['newton_iteration_s']):>18.4f} "
-              f"{r['newton_iterations']:>8} {r['fenicsx_over_this']:>12}")
+        print(f"{r['unknowns']:>9} {r['contender']:<36} {float(r['newton_iteration_s']):>18.4f} "
+              f"{r['newton_iterations']:>8} {r['fenicsx_over_this']:>12} {r['difference']:>9}")
     if args.csv:
         with open(args.csv, "w", newline="") as f:
             w = csv.DictWriter(f, fieldnames=list(rows[0]))

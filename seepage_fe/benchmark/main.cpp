@@ -73,6 +73,7 @@ struct Contender {
   seepage::Solver::State start;  // every round times the step from here
   seepage::Timings best{};  // the round with the cheapest Newton iteration
   double best_per_iteration = std::numeric_limits<double>::infinity();
+  double difference = 0;  // max |u - u_reference| / max |u_reference| after a round
   long steps = 0;
 };
 
@@ -86,26 +87,41 @@ seepage::Timings minus(const seepage::Timings& a, const seepage::Timings& b) {
   return d;
 }
 
+seepage::LinearSolver linear_solver(const std::string& name) {
+  if (name == "cg") return seepage::LinearSolver::cg;
+  if (name == "lagged") return seepage::LinearSolver::lagged;
+  return seepage::LinearSolver::direct;
+}
+
 void newton_rows(const Case& c, const std::vector<std::string>& linear_solvers, double dt, double cg_tolerance,
-                 int rounds, std::FILE* csv) {
+                 int rounds, int steps, std::FILE* csv) {
   std::vector<Contender> contenders;
   for (const auto& name : linear_solvers) {
     seepage::Settings settings;
     settings.scheme = seepage::TimeScheme::backward_euler;
-    settings.linear_solver = name == "cg" ? seepage::LinearSolver::cg : seepage::LinearSolver::direct;
+    settings.linear_solver = linear_solver(name);
     settings.cg_tolerance = cg_tolerance;
     contenders.push_back({name, std::make_unique<seepage::Solver>(c.mesh, c.model, settings), {}});
     contenders.back().solver->advance(dt);  // first touch of every array
     contenders.back().start = contenders.back().solver->save_state();
   }
-  // Every round the same step, from the same state: a round's cost must not
-  // depend on where the solution has got to (CG's iterations do).
+  // Every round the same steps, from the same state and with nothing
+  // factorised: a round's cost must not depend on where the solution has got
+  // to (CG's iterations do) nor on a factor an earlier round left (the lagged
+  // solver's).
+  Eigen::VectorXd reference;  // the first contender's solution after its round
   for (int r = 0; r < rounds; ++r)
     for (auto& k : contenders) {
       k.solver->restore_state(k.start);
+      k.solver->drop_factorisation();
       const auto before = k.solver->timings();
-      k.solver->advance(dt);
+      for (int step = 0; step < steps; ++step) k.solver->advance(dt);
       const auto d = minus(k.solver->timings(), before);
+      const Eigen::VectorXd& u = k.solver->unknown();
+      if (&k == &contenders.front())
+        reference = u;
+      else
+        k.difference = std::max(k.difference, (u - reference).lpNorm<Eigen::Infinity>() / reference.lpNorm<Eigen::Infinity>());
       const double per_iteration = d.total_step / static_cast<double>(d.nonlinear_iterations);
       ++k.steps;
       if (per_iteration < k.best_per_iteration) {
@@ -117,20 +133,22 @@ void newton_rows(const Case& c, const std::vector<std::string>& linear_solvers, 
   for (const auto& k : contenders) {
     const auto& t = k.best;
     const double its = static_cast<double>(t.nonlinear_iterations);
-    const std::string method =
-        k.linear_solver == "cg" ? "cg/incomplete_cholesky" : k.solver->factorisation().name();
+    const std::string method = k.linear_solver == "cg"       ? "cg/incomplete_cholesky"
+                               : k.linear_solver == "lagged" ? "cg/" + k.solver->factorisation().name()
+                                                             : k.solver->factorisation().name();
     const long unknowns = static_cast<long>(c.mesh.num_nodes());
     const double cg_iterations = static_cast<double>(t.linear_iterations) / its;
-    std::printf("%9ld %-14s %7.0e %-7s %-24s %7.0f %10.4f %9.4f %9.4f %9.4f %8.1f %8.3f\n", unknowns,
+    std::printf("%9ld %-14s %7.0e %-7s %-24s %7.0f %10.4f %9.4f %9.4f %9.4f %8.1f %8.3f %9.1e\n", unknowns,
                 c.mesh_name.c_str(), dt, k.linear_solver.c_str(), method.c_str(), its, k.best_per_iteration,
                 t.factorization / its, t.solve / its, (t.total_step - t.factorization - t.solve) / its,
-                cg_iterations, k.best_per_iteration / direct);
+                cg_iterations, k.best_per_iteration / direct, k.difference);
     std::fflush(stdout);
     if (csv)
-      std::fprintf(csv, "%ld,%s,%g,%s,%s,%g,%.0f,%.6g,%.6g,%.6g,%.6g,%.1f,%.4f\n", unknowns, c.mesh_name.c_str(),
-                   dt, k.linear_solver.c_str(), method.c_str(), k.linear_solver == "cg" ? cg_tolerance : 0.0, its,
+      std::fprintf(csv, "%ld,%s,%g,%d,%s,%s,%g,%.0f,%.6g,%.6g,%.6g,%.6g,%.1f,%.4f,%.3g\n", unknowns, c.mesh_name.c_str(),
+                   dt, steps, k.linear_solver.c_str(), method.c_str(), k.linear_solver == "direct" ? 0.0 : cg_tolerance, its,
                    k.best_per_iteration, t.factorization / its, t.solve / its,
-                   (t.total_step - t.factorization - t.solve) / its, cg_iterations, k.best_per_iteration / direct);
+                   (t.total_step - t.factorization - t.solve) / its, cg_iterations, k.best_per_iteration / direct,
+                   k.difference);
   }
 }
 
@@ -213,7 +231,7 @@ int main(int argc, char** argv) {
   std::string csv_path, orderings_path;
   std::vector<double> time_steps{1e-3};
   double cg_tolerance = seepage::Settings{}.cg_tolerance;
-  int rounds = 3;
+  int rounds = 3, steps = 1;
   long simplicial_up_to = std::numeric_limits<long>::max();
   bool no_newton = false, no_orderings = false;
   app.add_option("cells", sides, "cells per side of the unit square, one case each (unknowns: (n + 1)^2)")
@@ -226,13 +244,16 @@ int main(int argc, char** argv) {
                  "write the factorisations' rows to this CSV (seepage_fe/benchmark/orderings.csv is one, from which "
                  "the solver's choice of mode and ordering is set)");
   app.add_option("--linear-solvers", linear_solvers, "linear solvers of the Newton rows, the first the reference")
-      ->check(CLI::IsMember({"direct", "cg"}))
+      ->check(CLI::IsMember({"direct", "cg", "lagged"}))
       ->capture_default_str();
   app.add_option("--time-step", time_steps, "time steps [s] of the Newton rows, rows for each (the factorisations' "
                                             "rows take the first)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  app.add_option("--cg-tolerance", cg_tolerance, "the cg rows' seepage.cg_tolerance")
+  app.add_option("--steps", steps, "time steps per round of the Newton rows, the first of them factorising afresh")
+      ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
+  app.add_option("--cg-tolerance", cg_tolerance, "the cg and lagged rows' seepage.cg_tolerance")
       ->check(CLI::Range(1e-16, 0.5))
       ->capture_default_str();
   app.add_option("--rounds", rounds, "rounds, each contender's best kept")->check(CLI::Range(1, 100))->capture_default_str();
@@ -247,9 +268,9 @@ int main(int argc, char** argv) {
     return app.exit(e) == 0 ? 0 : 2;
   }
   try {
-    std::FILE* csv = open_csv(csv_path, "unknowns,mesh,time_step_s,linear_solver,method,cg_tolerance,"
+    std::FILE* csv = open_csv(csv_path, "unknowns,mesh,time_step_s,steps,linear_solver,method,cg_tolerance,"
                                         "newton_iterations,newton_iteration_s,factor_s,solve_s,other_s,"
-                                        "cg_iterations,over_reference");
+                                        "cg_iterations,over_reference,difference");
     std::FILE* orderings = open_csv(orderings_path, "unknowns,mesh,mode,ordering,analyse_s,factor_solve_s,"
                                                     "factor_nonzeros,flops,over_fastest,chosen");
     std::vector<Case> cases;
@@ -257,11 +278,11 @@ int main(int argc, char** argv) {
     for (const auto& m : meshes) cases.push_back(gmsh(m));
     std::printf("BLAS: %s; %d rounds, best kept\n", blas::description().c_str(), rounds);
     if (!no_newton) {
-      std::printf("\nPer Newton iteration [s] (other: residuals, Jacobian values, line search, bookkeeping)\n");
-      std::printf("%9s %-14s %7s %-7s %-24s %7s %10s %9s %9s %9s %8s %8s\n", "unknowns", "mesh", "dt", "solver", "method",
-                  "Newton", "per it.", "factor", "solve", "other", "cg its", "/ first");
+      std::printf("\nPer Newton iteration [s] (other: residuals, Jacobian values, line search, bookkeeping; differs: max |u - u_first| / max |u_first| after the round)\n");
+      std::printf("%9s %-14s %7s %-7s %-24s %7s %10s %9s %9s %9s %8s %8s %9s\n", "unknowns", "mesh", "dt", "solver",
+                  "method", "Newton", "per it.", "factor", "solve", "other", "cg its", "/ first", "differs");
       for (const auto& c : cases)
-        for (double dt : time_steps) newton_rows(c, linear_solvers, dt, cg_tolerance, rounds, csv);
+        for (double dt : time_steps) newton_rows(c, linear_solvers, dt, cg_tolerance, rounds, steps, csv);
     }
     if (!no_orderings) {
       std::printf("\nCHOLMOD factor-and-solve of the Jacobian\n");
