@@ -4,6 +4,7 @@
 // bounding boxes makes a query O(1) on any mesh; the exact test is the inverse
 // isoparametric map of the few candidate cells.
 
+#include <array>
 #include <optional>
 #include <vector>
 
@@ -13,42 +14,50 @@
 
 namespace outburst::seepage {
 
-class CellLocator {
+template <int Dim>
+class CellLocatorOf {
  public:
-  explicit CellLocator(const Mesh& mesh);
+  using Point = typename MeshOf<Dim>::Point;
+  using Jacobian = Eigen::Matrix<double, Dim, Dim>;
+
+  explicit CellLocatorOf(const MeshOf<Dim>& mesh);
 
   struct Hit {
     int cell;
-    Eigen::Vector2d reference;  // coordinates in [-1, 1]^2
-    // d(xi, eta) / d(x, y) of a parallelogram, constant over the cell; null
-    // for other cells. Samplers take gradients from it without a Jacobian.
-    const Eigen::Matrix2d* inverse_jacobian = nullptr;
+    Point reference;  // coordinates in [-1, 1]^Dim
+    // d(reference) / d(x) of a parallelogram (parallelepiped), constant over
+    // the cell; null for other cells. Samplers take gradients from it without
+    // a Jacobian.
+    const Jacobian* inverse_jacobian = nullptr;
   };
   // `hint`, if given, is a cell to try first (where the point was last time);
   // it is updated to the cell found. Any hint is safe: a wrong one costs one test.
-  std::optional<Hit> locate(const Eigen::Vector2d& point, int* hint = nullptr) const;
+  std::optional<Hit> locate(const Point& point, int* hint = nullptr) const;
   // Buckets of the search grid: at most one per cell.
   std::size_t buckets() const { return bucket_start_.size() - 1; }
 
  private:
-  const Mesh& mesh_;
-  Eigen::Vector2d lower_, bucket_size_;
-  int nx_ = 1, ny_ = 1;
+  const MeshOf<Dim>& mesh_;
+  Point lower_, bucket_size_;
+  std::array<int, Dim> along_{};   // buckets along each axis
   std::vector<int> bucket_start_;  // CSR layout: cells of bucket b are
   std::vector<int> bucket_cells_;  // bucket_cells_[bucket_start_[b] .. bucket_start_[b+1])
-  std::vector<Eigen::Vector2d> box_lower_, box_upper_;  // bounding box per cell
+  std::vector<Point> box_lower_, box_upper_;  // bounding box per cell
   // A parallelogram's map to the reference square is affine: its reference
   // coordinates are inverse_jacobian (x - centre), with no Newton iteration.
   // Coupled runs locate every particle every step, and most meshes are of
   // such cells (structured and transfinite ones all are).
   struct Affine {
-    Eigen::Vector2d centre;
-    Eigen::Matrix2d inverse_jacobian;
+    Point centre;
+    Jacobian inverse_jacobian;
   };
   std::vector<std::optional<Affine>> affine_;
   // The reference coordinates of point in cell c, or nullopt outside it.
-  std::optional<Eigen::Vector2d> reference(std::size_t c, const Eigen::Vector2d& point) const;
-  Hit hit(std::size_t c, const Eigen::Vector2d& reference) const;
+  std::optional<Point> reference(std::size_t c, const Point& point) const;
+  Hit hit(std::size_t c, const Point& reference) const;
+  int bucket_index(const Point& p, int axis) const;
 };
+
+using CellLocator = CellLocatorOf<2>;
 
 }  // namespace outburst::seepage

@@ -12,25 +12,33 @@
 
 #include <fmt/format.h>
 
+#include "seepage_fe/q1.hpp"
+
 namespace outburst::seepage {
 
-int Mesh::region_index(const std::string& name) const {
+template <int Dim>
+int MeshOf<Dim>::region_index(const std::string& name) const {
   for (std::size_t i = 0; i < region_names.size(); ++i)
     if (region_names[i] == name) return static_cast<int>(i);
   return -1;
 }
 
-const Mesh::Boundary* Mesh::boundary(const std::string& name) const {
+template <int Dim>
+const typename MeshOf<Dim>::Boundary* MeshOf<Dim>::boundary(const std::string& name) const {
   for (const auto& b : boundaries)
     if (b.name == name) return &b;
   return nullptr;
 }
 
-std::vector<std::string> Mesh::boundary_names() const {
+template <int Dim>
+std::vector<std::string> MeshOf<Dim>::boundary_names() const {
   std::vector<std::string> names;
   for (const auto& b : boundaries) names.push_back(b.name);
   return names;
 }
+
+template struct MeshOf<2>;
+template struct MeshOf<3>;
 
 namespace {
 
@@ -80,12 +88,12 @@ Mesh make_structured_mesh(const StructuredMeshSpec& spec) {
   }
   Mesh::Boundary left{"left", {}}, right{"right", {}}, bottom{"bottom", {}}, top{"top", {}};
   for (int j = 0; j < ny; ++j) {
-    left.edges.push_back({id(0, j + 1), id(0, j)});
-    right.edges.push_back({id(nx, j), id(nx, j + 1)});
+    left.faces.push_back({id(0, j + 1), id(0, j)});
+    right.faces.push_back({id(nx, j), id(nx, j + 1)});
   }
   for (int i = 0; i < nx; ++i) {
-    bottom.edges.push_back({id(i, 0), id(i + 1, 0)});
-    top.edges.push_back({id(i + 1, ny), id(i, ny)});
+    bottom.faces.push_back({id(i, 0), id(i + 1, 0)});
+    top.faces.push_back({id(i + 1, ny), id(i, ny)});
   }
   mesh.boundaries = {left, right, bottom, top};
   return mesh;
@@ -380,7 +388,7 @@ Mesh read_gmsh(const std::filesystem::path& file, double length_scale) {
       mesh.boundaries.push_back(
           {name != physical_names.end() ? name->second : fmt::format("{}", e.physical), {}});
     }
-    mesh.boundaries[it->second].edges.push_back({a->second, b->second});
+    mesh.boundaries[it->second].faces.push_back({a->second, b->second});
   }
   check_mesh(mesh, file.string());
   return mesh;
@@ -400,6 +408,66 @@ void check_mesh(const Mesh& mesh, const std::string& source) {
             source, c, mesh.nodes[cell[0]].x(), mesh.nodes[cell[0]].y(), mesh.nodes[cell[1]].x(),
             mesh.nodes[cell[1]].y(), mesh.nodes[cell[2]].x(), mesh.nodes[cell[2]].y(),
             mesh.nodes[cell[3]].x(), mesh.nodes[cell[3]].y(), k));
+    }
+  }
+}
+
+Mesh3 make_box_mesh(const BoxMeshSpec& spec) {
+  for (int d = 0; d < 3; ++d)
+    if (spec.cells[d] < 1 || !(spec.size[d] > 0))
+      throw std::invalid_argument(fmt::format("a box mesh needs a positive size and at least one cell along each "
+                                              "axis; axis {} has {} cells over {:g} m",
+                                              d, spec.cells[d], spec.size[d]));
+  const int nx = spec.cells[0], ny = spec.cells[1], nz = spec.cells[2];
+  std::array<std::vector<double>, 3> at;
+  for (int d = 0; d < 3; ++d) at[d] = graded_coordinates(spec.origin[d], spec.size[d], spec.cells[d], spec.grading[d]);
+  Mesh3 mesh;
+  const auto id = [nx, ny](int i, int j, int k) { return (k * (ny + 1) + j) * (nx + 1) + i; };
+  for (int k = 0; k <= nz; ++k)
+    for (int j = 0; j <= ny; ++j)
+      for (int i = 0; i <= nx; ++i) mesh.nodes.emplace_back(at[0][i], at[1][j], at[2][k]);
+  mesh.region_names = {"domain"};
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) {
+        mesh.cells.push_back({id(i, j, k), id(i + 1, j, k), id(i + 1, j + 1, k), id(i, j + 1, k), id(i, j, k + 1),
+                              id(i + 1, j, k + 1), id(i + 1, j + 1, k + 1), id(i, j + 1, k + 1)});
+        mesh.cell_region.push_back(0);
+      }
+  Mesh3::Boundary left{"left", {}}, right{"right", {}}, bottom{"bottom", {}}, top{"top", {}}, back{"back", {}},
+      front{"front", {}};
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j) {
+      left.faces.push_back({id(0, j, k), id(0, j, k + 1), id(0, j + 1, k + 1), id(0, j + 1, k)});
+      right.faces.push_back({id(nx, j, k), id(nx, j + 1, k), id(nx, j + 1, k + 1), id(nx, j, k + 1)});
+    }
+  for (int k = 0; k < nz; ++k)
+    for (int i = 0; i < nx; ++i) {
+      bottom.faces.push_back({id(i, 0, k), id(i + 1, 0, k), id(i + 1, 0, k + 1), id(i, 0, k + 1)});
+      top.faces.push_back({id(i, ny, k), id(i, ny, k + 1), id(i + 1, ny, k + 1), id(i + 1, ny, k)});
+    }
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      back.faces.push_back({id(i, j, 0), id(i, j + 1, 0), id(i + 1, j + 1, 0), id(i + 1, j, 0)});
+      front.faces.push_back({id(i, j, nz), id(i + 1, j, nz), id(i + 1, j + 1, nz), id(i, j + 1, nz)});
+    }
+  mesh.boundaries = {left, right, bottom, top, back, front};
+  check_mesh(mesh, "the generated box");
+  return mesh;
+}
+
+void check_mesh(const Mesh3& mesh, const std::string& source) {
+  // A trilinear map is invertible if its Jacobian is positive at the corners
+  // (for the hexahedra meshers make); the corners' edge triples give it.
+  for (std::size_t c = 0; c < mesh.cells.size(); ++c) {
+    const auto x = mesh.corners(c);
+    for (int a = 0; a < 8; ++a) {
+      const Eigen::Vector3d r(q1::hex_corner[a][0], q1::hex_corner[a][1], q1::hex_corner[a][2]);
+      const double det = q1::evaluate(x, r).det_j;
+      if (!(det > 0))
+        throw std::runtime_error(fmt::format(
+            "{}: hexahedron {} (first corner at ({:g}, {:g}, {:g})) is degenerate or inverted at its corner {}",
+            source, c, x[0].x(), x[0].y(), x[0].z(), a));
     }
   }
 }

@@ -1,6 +1,7 @@
 #pragma once
-// Quadrilateral meshes for the seepage solver: generated structured rectangles
-// (with optional geometric grading) or unstructured quads read from Gmsh.
+// Meshes for the seepage solver: generated structured rectangles (with optional
+// geometric grading) or unstructured quads read from Gmsh; generated boxes of
+// hexahedra in 3D.
 //
 // Regions (cell sets with their own material) and boundaries (edge sets where
 // conditions apply) are named: "left", "right", "bottom", "top" on generated
@@ -15,29 +16,50 @@
 
 namespace outburst::seepage {
 
-struct Mesh {
+// Q1 meshes in Dim = 2 (quadrilaterals) or 3 (hexahedra) dimensions. A
+// boundary is a set of faces: edges in 2D, quadrilaterals in 3D.
+template <int Dim>
+struct MeshOf {
+  static_assert(Dim == 2 || Dim == 3);
+  static constexpr int dim = Dim;
+  static constexpr int cell_corners = 1 << Dim;
+  static constexpr int face_corners = 1 << (Dim - 1);
+  using Point = Eigen::Matrix<double, Dim, 1>;
+  using Cell = std::array<int, cell_corners>;
+  using Face = std::array<int, face_corners>;
+
   struct Boundary {
     std::string name;
-    std::vector<std::array<int, 2>> edges;
+    std::vector<Face> faces;
   };
 
-  std::vector<Eigen::Vector2d> nodes;
-  std::vector<std::array<int, 4>> cells;  // counter-clockwise
+  std::vector<Point> nodes;
+  // Quadrilaterals counter-clockwise; hexahedra in Gmsh's order (q1::hex_corner).
+  std::vector<Cell> cells;
   std::vector<int> cell_region;           // index into region_names
   std::vector<std::string> region_names;
   std::vector<Boundary> boundaries;
 
   std::size_t num_nodes() const { return nodes.size(); }
   std::size_t num_cells() const { return cells.size(); }
-  std::array<Eigen::Vector2d, 4> corners(std::size_t cell) const {
-    const auto& c = cells[cell];
-    return {nodes[c[0]], nodes[c[1]], nodes[c[2]], nodes[c[3]]};
+  std::array<Point, cell_corners> corners(std::size_t cell) const {
+    std::array<Point, cell_corners> x;
+    for (int a = 0; a < cell_corners; ++a) x[a] = nodes[cells[cell][a]];
+    return x;
+  }
+  std::array<Point, face_corners> face_corners_of(const Face& face) const {
+    std::array<Point, face_corners> x;
+    for (int a = 0; a < face_corners; ++a) x[a] = nodes[face[a]];
+    return x;
   }
   // -1 when absent.
   int region_index(const std::string& name) const;
   const Boundary* boundary(const std::string& name) const;
   std::vector<std::string> boundary_names() const;
 };
+
+using Mesh = MeshOf<2>;
+using Mesh3 = MeshOf<3>;
 
 struct StructuredMeshSpec {
   Eigen::Vector2d origin{0.0, 0.0};
@@ -57,13 +79,26 @@ struct StructuredMeshSpec {
 // Throws std::invalid_argument naming the region when a cell has none.
 Mesh make_structured_mesh(const StructuredMeshSpec& spec);
 
+// A box of hexahedra, uniform or graded along each axis; its boundaries are
+// "left" and "right" (x), "bottom" and "top" (y), "back" and "front" (z), each
+// face's corners counter-clockwise seen from outside. One region, "domain".
+struct BoxMeshSpec {
+  Eigen::Vector3d origin{0.0, 0.0, 0.0};
+  Eigen::Vector3d size{1.0, 1.0, 1.0};
+  std::array<int, 3> cells{1, 1, 1};
+  std::array<double, 3> grading{1.0, 1.0, 1.0};  // last over first cell size
+};
+Mesh3 make_box_mesh(const BoxMeshSpec& spec);
+
 // Gmsh MSH 4.1 ASCII with physical groups: 2D groups become regions (4-node quads
 // only), 1D groups boundaries. Coordinates are multiplied by `length_scale` (to m).
 // Errors (std::runtime_error) name the file, the line and what was expected.
 Mesh read_gmsh(const std::filesystem::path& file, double length_scale = 1.0);
 
-// Checks every cell has positive area and counter-clockwise, convex corners;
-// throws std::runtime_error naming the first bad cell.
+// Checks every cell has positive area and counter-clockwise, convex corners
+// (a hexahedron: a positive Jacobian at each corner); throws
+// std::runtime_error naming the first bad cell.
 void check_mesh(const Mesh& mesh, const std::string& source);
+void check_mesh(const Mesh3& mesh, const std::string& source);
 
 }  // namespace outburst::seepage

@@ -1,6 +1,9 @@
 #pragma once
-// The bilinear quadrilateral (Q1): shape functions on the reference square
-// [-1, 1]^2, the isoparametric map, and the element integrals the solver needs.
+// The Q1 elements: the bilinear quadrilateral on the reference square
+// [-1, 1]^2 and the trilinear hexahedron on the cube [-1, 1]^3, their
+// isoparametric maps, and the element integrals the solver needs. The
+// hexahedron's functions overload the quadrilateral's, so code written once
+// for both dimensions calls them by the same names.
 
 #include <algorithm>
 #include <array>
@@ -8,6 +11,7 @@
 #include <optional>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <Eigen/LU>
 
 namespace outburst::seepage::q1 {
@@ -143,6 +147,184 @@ inline std::optional<Eigen::Vector2d> inverse_map(const Corners& x, const Eigen:
   // bilinear map need not be invertible there): that is a miss, not a hit.
   if (!converged || ref.lpNorm<Eigen::Infinity>() > 1 + 1e-9) return std::nullopt;
   return ref.cwiseMax(-1.0).cwiseMin(1.0);
+}
+
+// ---- the trilinear hexahedron
+
+using Corners3 = std::array<Eigen::Vector3d, 8>;
+
+// Reference corners in Gmsh's order: the face zeta = -1 counter-clockwise
+// seen from +zeta, from (-1, -1, -1), then the face zeta = +1 the same way.
+inline constexpr double hex_corner[8][3] = {{-1, -1, -1}, {1, -1, -1}, {1, 1, -1}, {-1, 1, -1},
+                                            {-1, -1, 1},  {1, -1, 1},  {1, 1, 1},  {-1, 1, 1}};
+
+inline std::array<double, 8> shape(const Eigen::Vector3d& r) {
+  std::array<double, 8> n{};
+  for (int a = 0; a < 8; ++a)
+    n[a] = 0.125 * (1 + hex_corner[a][0] * r[0]) * (1 + hex_corner[a][1] * r[1]) * (1 + hex_corner[a][2] * r[2]);
+  return n;
+}
+
+// d N_a / d(xi, eta, zeta).
+inline std::array<Eigen::Vector3d, 8> reference_gradients(const Eigen::Vector3d& r) {
+  std::array<Eigen::Vector3d, 8> d;
+  for (int a = 0; a < 8; ++a) {
+    const double f[3] = {1 + hex_corner[a][0] * r[0], 1 + hex_corner[a][1] * r[1], 1 + hex_corner[a][2] * r[2]};
+    d[a] = 0.125 * Eigen::Vector3d(hex_corner[a][0] * f[1] * f[2], f[0] * hex_corner[a][1] * f[2],
+                                   f[0] * f[1] * hex_corner[a][2]);
+  }
+  return d;
+}
+
+struct Point3 {
+  std::array<double, 8> n;
+  std::array<Eigen::Vector3d, 8> grad;
+  double det_j;
+};
+
+inline Point3 evaluate(const Corners3& x, const Eigen::Vector3d& r) {
+  Point3 p{shape(r), {}, 0.0};
+  const auto dref = reference_gradients(r);
+  Eigen::Matrix3d jac = Eigen::Matrix3d::Zero();  // d(x, y, z) / d(xi, eta, zeta)
+  for (int a = 0; a < 8; ++a) jac += x[a] * dref[a].transpose();
+  p.det_j = jac.determinant();
+  const Eigen::Matrix3d inv_t = jac.inverse().transpose();
+  for (int a = 0; a < 8; ++a) p.grad[a] = inv_t * dref[a];
+  return p;
+}
+
+struct Sample3 {
+  double value;
+  Eigen::Vector3d gradient;
+};
+template <class Nodal>
+Sample3 sample(const Corners3& x, const std::array<int, 8>& nodes, const Nodal& u, const Eigen::Vector3d& reference) {
+  const Point3 p = evaluate(x, reference);
+  Sample3 s{0.0, Eigen::Vector3d::Zero()};
+  for (int a = 0; a < 8; ++a) {
+    const double ua = u[nodes[a]];
+    s.value += p.n[a] * ua;
+    s.gradient += p.grad[a] * ua;
+  }
+  return s;
+}
+
+// The same on a parallelepiped, from its constant inverse Jacobian.
+template <class Nodal>
+Sample3 sample_affine(const std::array<int, 8>& nodes, const Nodal& u, const Eigen::Vector3d& reference,
+                      const Eigen::Matrix3d& inverse_jacobian) {
+  const auto n = shape(reference);
+  const auto dref = reference_gradients(reference);
+  double value = 0;
+  Eigen::Vector3d along = Eigen::Vector3d::Zero();  // d u / d(xi, eta, zeta)
+  for (int a = 0; a < 8; ++a) {
+    const double ua = u[nodes[a]];
+    value += n[a] * ua;
+    along += dref[a] * ua;
+  }
+  return {value, inverse_jacobian.transpose() * along};
+}
+
+// 2x2x2 Gauss points, exact for the trilinear stiffness on parallelepipeds.
+inline const std::array<Eigen::Vector3d, 8>& gauss2_points3() {
+  static const std::array<Eigen::Vector3d, 8> points = [] {
+    std::array<Eigen::Vector3d, 8> g;
+    for (int a = 0; a < 8; ++a)
+      g[a] = gauss2 * Eigen::Vector3d(hex_corner[a][0], hex_corner[a][1], hex_corner[a][2]);
+    return g;
+  }();
+  return points;
+}
+
+struct Integrals3 {
+  Eigen::Matrix<double, 8, 8> stiffness;  // int grad N_a . grad N_b dV (unit conductivity)
+  Eigen::Matrix<double, 8, 1> lumped;     // int N_a dV
+};
+
+inline Integrals3 integrals(const Corners3& x) {
+  Integrals3 r{Eigen::Matrix<double, 8, 8>::Zero(), Eigen::Matrix<double, 8, 1>::Zero()};
+  for (const auto& g : gauss2_points3()) {
+    const Point3 p = evaluate(x, g);
+    for (int a = 0; a < 8; ++a) {
+      r.lumped[a] += p.n[a] * p.det_j;
+      for (int b = 0; b < 8; ++b) r.stiffness(a, b) += p.grad[a].dot(p.grad[b]) * p.det_j;
+    }
+  }
+  return r;
+}
+
+// Reference coordinates of `point` in the hexahedron, or nullopt outside it;
+// the quadrilateral's tolerances, for the same reasons.
+inline std::optional<Eigen::Vector3d> inverse_map(const Corners3& x, const Eigen::Vector3d& point) {
+  double reach = 0, thinnest = std::numeric_limits<double>::infinity();
+  for (int a = 0; a < 8; ++a) reach = std::max(reach, x[a].lpNorm<Eigen::Infinity>());
+  for (int a = 0; a < 4; ++a) {  // the twelve edges: around both faces, and between them
+    thinnest = std::min({thinnest, (x[(a + 1) % 4] - x[a]).norm(), (x[4 + (a + 1) % 4] - x[4 + a]).norm(),
+                         (x[a + 4] - x[a]).norm()});
+  }
+  const double tolerance = std::max(1e-13, 64 * std::numeric_limits<double>::epsilon() * reach / thinnest);
+  Eigen::Vector3d ref = Eigen::Vector3d::Zero();
+  bool converged = false;
+  for (int it = 0; it < 30; ++it) {
+    const auto n = shape(ref);
+    const auto dref = reference_gradients(ref);
+    Eigen::Vector3d mapped = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d jac = Eigen::Matrix3d::Zero();
+    for (int a = 0; a < 8; ++a) {
+      mapped += n[a] * x[a];
+      jac += x[a] * dref[a].transpose();
+    }
+    const Eigen::Vector3d step = jac.inverse() * (point - mapped);
+    ref += step;
+    if (step.lpNorm<Eigen::Infinity>() < tolerance) {
+      converged = true;
+      break;
+    }
+    if (ref.lpNorm<Eigen::Infinity>() > 10) return std::nullopt;
+  }
+  if (!converged || ref.lpNorm<Eigen::Infinity>() > 1 + 1e-9) return std::nullopt;
+  return ref.cwiseMax(-1.0).cwiseMin(1.0);
+}
+
+// ---- both dimensions by one name
+
+inline Point evaluate(const Corners& x, const Eigen::Vector2d& r) { return evaluate(x, r.x(), r.y()); }
+
+// The 2^Dim Gauss points of the 2x2(x2) rule.
+template <int Dim>
+const std::array<Eigen::Matrix<double, Dim, 1>, (1 << Dim)>& gauss_points() {
+  if constexpr (Dim == 2) {
+    static const std::array<Eigen::Vector2d, 4> points{
+        Eigen::Vector2d(gauss2_points[0][0], gauss2_points[0][1]), Eigen::Vector2d(gauss2_points[1][0], gauss2_points[1][1]),
+        Eigen::Vector2d(gauss2_points[2][0], gauss2_points[2][1]), Eigen::Vector2d(gauss2_points[3][0], gauss2_points[3][1])};
+    return points;
+  } else {
+    return gauss2_points3();
+  }
+}
+
+// ---- boundary faces: int N_a dS of each corner of a face
+
+// An edge (2D): half its length at each end.
+inline std::array<double, 2> face_lumped(const std::array<Eigen::Vector2d, 2>& x) {
+  const double half = 0.5 * (x[1] - x[0]).norm();
+  return {half, half};
+}
+
+// A bilinear quadrilateral in space (3D), by 2x2 Gauss points.
+inline std::array<double, 4> face_lumped(const std::array<Eigen::Vector3d, 4>& x) {
+  std::array<double, 4> w{};
+  for (const auto& g : gauss2_points) {
+    Eigen::Vector3d along_xi = Eigen::Vector3d::Zero(), along_eta = Eigen::Vector3d::Zero();
+    for (int a = 0; a < 4; ++a) {
+      along_xi += 0.25 * corner_xi[a] * (1 + corner_eta[a] * g[1]) * x[a];
+      along_eta += 0.25 * corner_eta[a] * (1 + corner_xi[a] * g[0]) * x[a];
+    }
+    const double area = along_xi.cross(along_eta).norm();
+    const auto n = shape(g[0], g[1]);
+    for (int a = 0; a < 4; ++a) w[a] += n[a] * area;
+  }
+  return w;
 }
 
 }  // namespace outburst::seepage::q1

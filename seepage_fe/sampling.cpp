@@ -4,12 +4,13 @@
 
 namespace outburst::seepage {
 
-Sampler::Sampler(const Mesh& mesh) : mesh_(mesh), locator_(mesh), area_(mesh.num_cells()) {
+template <int Dim>
+SamplerOf<Dim>::SamplerOf(const MeshOf<Dim>& mesh) : mesh_(mesh), locator_(mesh), area_(mesh.num_cells()) {
   for (std::size_t c = 0; c < mesh_.num_cells(); ++c) area_[c] = q1::integrals(mesh_.corners(c)).lumped.sum();
 }
 
-std::optional<Sampler::Value> Sampler::sample(const Eigen::VectorXd& nodal, const Eigen::Vector2d& x,
-                                              int* hint) const {
+template <int Dim>
+auto SamplerOf<Dim>::sample(const Eigen::VectorXd& nodal, const Point& x, int* hint) const -> std::optional<Value> {
   const auto hit = locator_.locate(x, hint);
   if (!hit) return std::nullopt;
   const auto c = static_cast<std::size_t>(hit->cell);
@@ -19,9 +20,13 @@ std::optional<Sampler::Value> Sampler::sample(const Eigen::VectorXd& nodal, cons
   return Value{s.value, s.gradient};
 }
 
-int Sampler::cell_of(const Eigen::Vector2d& x, int* hint) const {
+template <int Dim>
+int SamplerOf<Dim>::cell_of(const Point& x, int* hint) const {
   const auto hit = locator_.locate(x, hint);
   return hit ? hit->cell : -1;
 }
+
+template class SamplerOf<2>;
+template class SamplerOf<3>;
 
 }  // namespace outburst::seepage

@@ -14,33 +14,38 @@
 
 namespace outburst::seepage {
 
-class Sampler {
+template <int Dim>
+class SamplerOf {
  public:
-  // Refers to `mesh`, which must outlive it and stay put.
-  explicit Sampler(const Mesh& mesh);
-  Sampler(const Sampler&) = delete;
-  Sampler& operator=(const Sampler&) = delete;
+  using Point = typename MeshOf<Dim>::Point;
 
-  const Mesh& mesh() const { return mesh_; }
-  // The area of each cell [m2].
+  // Refers to `mesh`, which must outlive it and stay put.
+  explicit SamplerOf(const MeshOf<Dim>& mesh);
+  SamplerOf(const SamplerOf&) = delete;
+  SamplerOf& operator=(const SamplerOf&) = delete;
+
+  const MeshOf<Dim>& mesh() const { return mesh_; }
+  // The area (3D: volume) of each cell [m2, m3].
   const std::vector<double>& cell_area() const { return area_; }
 
   struct Value {
     double value;
-    Eigen::Vector2d gradient;
+    Point gradient;
   };
-  // A nodal field (indexed by node) and its gradient at x, by the bilinear
-  // shape functions of the cell holding it; nullopt outside the mesh. `hint`:
-  // a cell to try first, updated to the cell found (any hint is safe; a wrong
+  // A nodal field (indexed by node) and its gradient at x, by the Q1 shape
+  // functions of the cell holding it; nullopt outside the mesh. `hint`: a
+  // cell to try first, updated to the cell found (any hint is safe; a wrong
   // one costs one test).
-  std::optional<Value> sample(const Eigen::VectorXd& nodal, const Eigen::Vector2d& x, int* hint = nullptr) const;
+  std::optional<Value> sample(const Eigen::VectorXd& nodal, const Point& x, int* hint = nullptr) const;
   // The cell holding x, or -1.
-  int cell_of(const Eigen::Vector2d& x, int* hint = nullptr) const;
+  int cell_of(const Point& x, int* hint = nullptr) const;
 
  private:
-  const Mesh& mesh_;
-  CellLocator locator_;
+  const MeshOf<Dim>& mesh_;
+  CellLocatorOf<Dim> locator_;
   std::vector<double> area_;
 };
+
+using Sampler = SamplerOf<2>;
 
 }  // namespace outburst::seepage

@@ -74,7 +74,8 @@ double Balance::total_outflow() const {
   return -std::accumulate(inflow_through_pressure.begin(), inflow_through_pressure.end(), 0.0);
 }
 
-Solver::Solver(Mesh mesh, Model model, Settings settings)
+template <int Dim>
+SolverOf<Dim>::SolverOf(MeshOf<Dim> mesh, Model model, Settings settings)
     : mesh_(std::move(mesh)),
       model_(std::move(model)),
       settings_(settings),
@@ -106,23 +107,25 @@ Solver::Solver(Mesh mesh, Model model, Settings settings)
   restart_balance();
 }
 
-void Solver::setup_system() {
+template <int Dim>
+void SolverOf<Dim>::setup_system() {
   const std::size_t n = mesh_.num_nodes(), nc = mesh_.num_cells();
   cell_stiffness_.resize(nc);
   cell_lumped_.resize(nc);
   capacity_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n));
   conductivity_.resize(nc);
   std::vector<Eigen::Triplet<double>> pattern;
-  pattern.reserve(nc * 16);
+  constexpr int N = cell_corners;
+  pattern.reserve(nc * N * N);
   for (std::size_t c = 0; c < nc; ++c) {
     const auto integrals = q1::integrals(mesh_.corners(c));
     cell_stiffness_[c] = integrals.stiffness;
     cell_lumped_[c] = integrals.lumped;
     const Material& m = model_.materials[mesh_.cell_region[c]];
     conductivity_[c] = m.conductivity;
-    for (int a = 0; a < 4; ++a) {
+    for (int a = 0; a < N; ++a) {
       capacity_[mesh_.cells[c][a]] += m.capacity * integrals.lumped[a];
-      for (int b = 0; b < 4; ++b) pattern.emplace_back(mesh_.cells[c][a], mesh_.cells[c][b], 0.0);
+      for (int b = 0; b < N; ++b) pattern.emplace_back(mesh_.cells[c][a], mesh_.cells[c][b], 0.0);
     }
   }
   stiffness_.resize(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(n));
@@ -138,9 +141,9 @@ void Solver::setup_system() {
   };
   scatter_.resize(nc);
   for (std::size_t c = 0; c < nc; ++c)
-    for (int a = 0; a < 4; ++a)
-      for (int b = 0; b < 4; ++b)
-        scatter_[c][4 * a + b] = value_index(mesh_.cells[c][a], mesh_.cells[c][b]);
+    for (int a = 0; a < N; ++a)
+      for (int b = 0; b < N; ++b)
+        scatter_[c][N * a + b] = value_index(mesh_.cells[c][a], mesh_.cells[c][b]);
   diagonal_.resize(n);
   for (std::size_t i = 0; i < n; ++i) diagonal_[i] = value_index(static_cast<int>(i), static_cast<int>(i));
 
@@ -154,8 +157,8 @@ void Solver::setup_system() {
     if (!boundary) throw std::invalid_argument(fmt::format("no boundary named '{}'", bc.boundary));
     if (bc.type != BoundaryCondition::Type::pressure) continue;
     pressure_bc_slot_[k] = slot++;
-    for (const auto& edge : boundary->edges)
-      for (int node : edge)
+    for (const auto& face : boundary->faces)
+      for (int node : face)
         if (fixed_by_[node] < 0) fixed_by_[node] = static_cast<int>(k);
   }
   boundary_fixed_by_ = fixed_by_;
@@ -183,7 +186,8 @@ void Solver::setup_system() {
     v->setZero(static_cast<Eigen::Index>(size));
 }
 
-void Solver::find_dirichlet_entries() {
+template <int Dim>
+void SolverOf<Dim>::find_dirichlet_entries() {
   dirichlet_diagonal_.clear();
   dirichlet_zero_.clear();
   for (Eigen::Index col = 0; col < stiffness_.outerSize(); ++col)
@@ -198,7 +202,8 @@ void Solver::find_dirichlet_entries() {
 
 // Open space is one more pressure condition, index K = number of the scene's
 // conditions, with its own balance slot added on first use.
-void Solver::set_open_nodes(const std::vector<char>& open, double pressure) {
+template <int Dim>
+void SolverOf<Dim>::set_open_nodes(const std::vector<char>& open, double pressure) {
   if (open.size() != mesh_.num_nodes())
     throw std::invalid_argument(fmt::format("set_open_nodes: {} flags for {} nodes", open.size(), mesh_.num_nodes()));
   if (model_.law == Law::gas && !(pressure > 0))
@@ -222,19 +227,21 @@ void Solver::set_open_nodes(const std::vector<char>& open, double pressure) {
   ++conductivity_version_;  // the Jacobian's rows changed: refactorise
 }
 
-void Solver::assemble_conductivity() {
+template <int Dim>
+void SolverOf<Dim>::assemble_conductivity() {
   ScopedTimer timer(timings_.assembly);
   double* values = stiffness_.valuePtr();
   std::fill(values, values + stiffness_.nonZeros(), 0.0);
   for (std::size_t c = 0; c < mesh_.num_cells(); ++c) {
     const double k = conductivity_[c];
     const double* ke = cell_stiffness_[c].data();  // column-major, symmetric
-    for (int e = 0; e < 16; ++e) values[scatter_[c][e]] += k * ke[e];
+    for (int e = 0; e < cell_corners * cell_corners; ++e) values[scatter_[c][e]] += k * ke[e];
   }
   ++conductivity_version_;
 }
 
-void Solver::set_conductivity(const std::vector<double>& per_cell) {
+template <int Dim>
+void SolverOf<Dim>::set_conductivity(const std::vector<double>& per_cell) {
   if (per_cell.size() != mesh_.num_cells())
     throw std::invalid_argument(fmt::format("set_conductivity: {} values for {} cells",
                                             per_cell.size(), mesh_.num_cells()));
@@ -247,7 +254,8 @@ void Solver::set_conductivity(const std::vector<double>& per_cell) {
   assemble_conductivity();
 }
 
-void Solver::set_initial_pressure(const std::vector<double>& nodal_p) {
+template <int Dim>
+void SolverOf<Dim>::set_initial_pressure(const std::vector<double>& nodal_p) {
   if (steps_ > 0) throw std::logic_error("set_initial_pressure: the run has already started");
   if (nodal_p.size() != mesh_.num_nodes())
     throw std::invalid_argument(fmt::format("set_initial_pressure: {} values for {} nodes",
@@ -262,14 +270,16 @@ void Solver::set_initial_pressure(const std::vector<double>& nodal_p) {
 }
 
 // The gas stored now becomes the balance's starting point.
-void Solver::restart_balance() {
+template <int Dim>
+void SolverOf<Dim>::restart_balance() {
   balance_.initial_stored = 0;
   for (Eigen::Index i = 0; i < u_.size(); ++i)
     balance_.initial_stored += capacity_[i] * storage_x(model_.law, u_[i]);
   balance_.stored = balance_.initial_stored;
 }
 
-void Solver::set_boundary_values(double t, Eigen::VectorXd& u) const {
+template <int Dim>
+void SolverOf<Dim>::set_boundary_values(double t, Eigen::VectorXd& u) const {
   for (std::size_t i = 0; i < fixed_by_.size(); ++i)
     if (fixed_by_[i] >= 0)
       u[static_cast<Eigen::Index>(i)] = unknown_from_pressure(
@@ -278,46 +288,48 @@ void Solver::set_boundary_values(double t, Eigen::VectorXd& u) const {
                           : open_pressure_);
 }
 
-void Solver::set_cell_source(std::vector<double> per_cell) {
+template <int Dim>
+void SolverOf<Dim>::set_cell_source(std::vector<double> per_cell) {
   if (!per_cell.empty() && per_cell.size() != mesh_.num_cells())
     throw std::invalid_argument(fmt::format("set_cell_source: {} values for {} cells", per_cell.size(),
                                             mesh_.num_cells()));
   cell_source_ = std::move(per_cell);
 }
 
-void Solver::add_storage(double per_pressure) {
+template <int Dim>
+void SolverOf<Dim>::add_storage(double per_pressure) {
   if (steps_ > 0) throw std::logic_error("add_storage: the run has already started");
   if (model_.law != Law::linear) throw std::invalid_argument("add_storage: only for the linear law");
   for (std::size_t c = 0; c < mesh_.num_cells(); ++c)
-    for (int a = 0; a < 4; ++a) capacity_[mesh_.cells[c][a]] += per_pressure * cell_lumped_[c][a];
+    for (int a = 0; a < cell_corners; ++a) capacity_[mesh_.cells[c][a]] += per_pressure * cell_lumped_[c][a];
   restart_balance();
 }
 
-void Solver::load_vector(double t, Eigen::VectorXd& f) const {
+template <int Dim>
+void SolverOf<Dim>::load_vector(double t, Eigen::VectorXd& f) const {
   f.setZero();
   for (const auto& bc : model_.boundary_conditions) {
     if (bc.type != BoundaryCondition::Type::flux) continue;
     const double q = bc.value(t);
     if (q == 0) continue;
-    for (const auto& edge : mesh_.boundary(bc.boundary)->edges) {
-      const double half = 0.5 * (mesh_.nodes[edge[1]] - mesh_.nodes[edge[0]]).norm();
-      f[edge[0]] += q * half;
-      f[edge[1]] += q * half;
+    for (const auto& face : mesh_.boundary(bc.boundary)->faces) {
+      const auto w = q1::face_lumped(mesh_.face_corners_of(face));
+      for (std::size_t a = 0; a < face.size(); ++a) f[face[a]] += q * w[a];
     }
   }
   for (std::size_t c = 0; c < cell_source_.size(); ++c) {
     if (cell_source_[c] == 0) continue;
-    for (int a = 0; a < 4; ++a) f[mesh_.cells[c][a]] += cell_source_[c] * cell_lumped_[c][a];
+    for (int a = 0; a < cell_corners; ++a) f[mesh_.cells[c][a]] += cell_source_[c] * cell_lumped_[c][a];
   }
   if (!source_) return;
   for (std::size_t c = 0; c < mesh_.num_cells(); ++c) {
     const auto x = mesh_.corners(c);
-    for (const auto& g : q1::gauss2_points) {
-      const auto p = q1::evaluate(x, g[0], g[1]);
-      Eigen::Vector2d at = Eigen::Vector2d::Zero();
-      for (int a = 0; a < 4; ++a) at += p.n[a] * x[a];
+    for (const auto& g : q1::gauss_points<Dim>()) {
+      const auto p = q1::evaluate(x, g);
+      Point at = Point::Zero();
+      for (int a = 0; a < cell_corners; ++a) at += p.n[a] * x[a];
       const double s = source_(at, t) * p.det_j;
-      for (int a = 0; a < 4; ++a) f[mesh_.cells[c][a]] += p.n[a] * s;
+      for (int a = 0; a < cell_corners; ++a) f[mesh_.cells[c][a]] += p.n[a] * s;
     }
   }
 }
@@ -326,7 +338,8 @@ void Solver::load_vector(double t, Eigen::VectorXd& f) const {
 // The full vector (fixed rows included) stays in r_ for the boundary reactions;
 // residual_scale_ is the size of the terms that cancel in it (storage and flux),
 // so that a residual at round-off of those terms counts as converged.
-double Solver::residual(const Eigen::VectorXd& u, double a0, double h) {
+template <int Dim>
+double SolverOf<Dim>::residual(const Eigen::VectorXd& u, double a0, double h) {
   ScopedTimer timer(timings_.residual);
   ++timings_.residual_evaluations;
   r_.noalias() = h * (stiffness_ * u);
@@ -343,7 +356,8 @@ double Solver::residual(const Eigen::VectorXd& u, double a0, double h) {
   return std::sqrt(norm2);
 }
 
-void Solver::build_jacobian(const Eigen::VectorXd& u, double a0, double h) {
+template <int Dim>
+void SolverOf<Dim>::build_jacobian(const Eigen::VectorXd& u, double a0, double h) {
   ScopedTimer timer(timings_.jacobian);
   const Law law = model_.law;
   double* j = jacobian_.valuePtr();
@@ -365,7 +379,8 @@ void Solver::build_jacobian(const Eigen::VectorXd& u, double a0, double h) {
   for (int e : dirichlet_diagonal_) j[e] = 1.0;
 }
 
-std::optional<std::string> Solver::try_step(double h, int& iterations) {
+template <int Dim>
+std::optional<std::string> SolverOf<Dim>::try_step(double h, int& iterations) {
   double a0 = 1, a1 = -1, a2 = 0;
   if (settings_.scheme == TimeScheme::bdf2 && has_previous_) {
     const double w = h / dt_previous_;
@@ -436,7 +451,8 @@ std::optional<std::string> Solver::try_step(double h, int& iterations) {
 // the reactions of the fixed nodes. The inflow of each step is therefore the
 // scheme's own quadrature I(n+1) = (a2 I(n) + h F + rho) / a0 (for backward
 // Euler simply h F + rho), which keeps stored + inflow exact for BDF2 as well.
-void Solver::accept_step(double h, double a0, double a2) {
+template <int Dim>
+void SolverOf<Dim>::accept_step(double h, double a0, double a2) {
   std::vector<double> rho(last_inflow_pressure_.size(), 0.0);
   for (Eigen::Index i = 0; i < r_.size(); ++i)
     if (fixed_by_[i] >= 0) rho[pressure_bc_slot_[fixed_by_[i]]] += r_[i];
@@ -458,7 +474,8 @@ void Solver::accept_step(double h, double a0, double a2) {
   balance_.stored = stored;
 }
 
-StepReport Solver::advance(double dt) {
+template <int Dim>
+StepReport SolverOf<Dim>::advance(double dt) {
   if (!(dt > 0)) throw std::invalid_argument(fmt::format("advance: dt = {} is not positive", dt));
   ScopedTimer timer(timings_.total_step);
   StepReport report;
@@ -492,7 +509,8 @@ StepReport Solver::advance(double dt) {
   return report;
 }
 
-std::optional<std::string> Solver::newton_direction(const Eigen::VectorXd& u, double a0, double h) {
+template <int Dim>
+std::optional<std::string> SolverOf<Dim>::newton_direction(const Eigen::VectorXd& u, double a0, double h) {
   for (Eigen::Index i = 0; i < r_.size(); ++i)
     if (fixed_by_[i] >= 0) r_[i] = 0;
   const FactorKey key{h, a0, conductivity_version_};
@@ -521,7 +539,8 @@ std::optional<std::string> Solver::newton_direction(const Eigen::VectorXd& u, do
   return solve_newton_system();
 }
 
-bool Solver::lagged_conjugate_gradients() {
+template <int Dim>
+bool SolverOf<Dim>::lagged_conjugate_gradients() {
   ScopedTimer timer(timings_.solve);
   lagged_cg_.compute(jacobian_);
   delta_ = lagged_cg_.solve(-r_);
@@ -533,7 +552,8 @@ bool Solver::lagged_conjugate_gradients() {
   return true;
 }
 
-std::optional<std::string> Solver::factorise() {
+template <int Dim>
+std::optional<std::string> SolverOf<Dim>::factorise() {
   ScopedTimer timer(timings_.factorization);
   ++timings_.factorizations;
   if (settings_.linear_solver == LinearSolver::cg) {
@@ -547,7 +567,8 @@ std::optional<std::string> Solver::factorise() {
   return std::nullopt;
 }
 
-std::optional<std::string> Solver::solve_newton_system() {
+template <int Dim>
+std::optional<std::string> SolverOf<Dim>::solve_newton_system() {
   ScopedTimer timer(timings_.solve);
   if (settings_.linear_solver == LinearSolver::cg) return conjugate_gradients();
   delta_ = factor_.solve(-r_);
@@ -555,7 +576,8 @@ std::optional<std::string> Solver::solve_newton_system() {
 }
 
 // J delta = -r from delta = 0, to cg_tolerance of |r|.
-std::optional<std::string> Solver::conjugate_gradients() {
+template <int Dim>
+std::optional<std::string> SolverOf<Dim>::conjugate_gradients() {
   delta_ = cg_.solve(-r_);
   timings_.linear_iterations += cg_.iterations();
   if (cg_.info() == Eigen::Success) return std::nullopt;
@@ -567,13 +589,15 @@ std::optional<std::string> Solver::conjugate_gradients() {
                      cg_.error(), cg_.iterations(), settings_.cg_max_iterations, settings_.cg_tolerance);
 }
 
-std::optional<double> Solver::pressure_at(const Eigen::Vector2d& x) const {
+template <int Dim>
+std::optional<double> SolverOf<Dim>::pressure_at(const Point& x) const {
   const auto s = sampler_.sample(u_, x);
   if (!s) return std::nullopt;
   return pressure_from_unknown(model_.law, s->value);
 }
 
-std::optional<Eigen::Vector2d> Solver::pressure_gradient_at(const Eigen::Vector2d& x) const {
+template <int Dim>
+auto SolverOf<Dim>::pressure_gradient_at(const Point& x) const -> std::optional<Point> {
   const auto s = sampler_.sample(u_, x);
   if (!s) return std::nullopt;
   if (model_.law == Law::linear) return s->gradient;
@@ -581,42 +605,47 @@ std::optional<Eigen::Vector2d> Solver::pressure_gradient_at(const Eigen::Vector2
   return s->gradient / (2.0 * std::sqrt(std::max(s->value, 1e-300)));
 }
 
-std::vector<double> Solver::nodal_pressure() const {
+template <int Dim>
+std::vector<double> SolverOf<Dim>::nodal_pressure() const {
   std::vector<double> p(static_cast<std::size_t>(u_.size()));
   for (Eigen::Index i = 0; i < u_.size(); ++i) p[i] = pressure_from_unknown(model_.law, u_[i]);
   return p;
 }
 
-std::vector<Eigen::Vector2d> Solver::cell_flux() const {
-  std::vector<Eigen::Vector2d> q(mesh_.num_cells());
+template <int Dim>
+auto SolverOf<Dim>::cell_flux() const -> std::vector<Point> {
+  std::vector<Point> q(mesh_.num_cells());
   for (std::size_t c = 0; c < mesh_.num_cells(); ++c) {
-    const auto p = q1::evaluate(mesh_.corners(c), 0.0, 0.0);
-    Eigen::Vector2d grad = Eigen::Vector2d::Zero();
-    for (int a = 0; a < 4; ++a) grad += p.grad[a] * u_[mesh_.cells[c][a]];
+    const auto p = q1::evaluate(mesh_.corners(c), Point(Point::Zero()));
+    Point grad = Point::Zero();
+    for (int a = 0; a < cell_corners; ++a) grad += p.grad[a] * u_[mesh_.cells[c][a]];
     q[c] = -conductivity_[c] * grad;
   }
   return q;
 }
 
-Solver::State Solver::save_state() const {
+template <int Dim>
+auto SolverOf<Dim>::save_state() const -> State {
   return {time_,     steps_,    u_, u_previous_, dt_previous_, has_previous_, conductivity_, balance_,
           last_inflow_pressure_, last_inflow_flux_, fixed_by_, pressure_bc_slot_, open_pressure_};
 }
 
 // A mesh file may change under an unchanged scene text.
-std::int64_t Solver::mesh_fingerprint() const {
+template <int Dim>
+std::int64_t SolverOf<Dim>::mesh_fingerprint() const {
   checkpoint::Fingerprint f;
   f.add(mesh_.nodes);
   f.add(mesh_.cells);
   f.add(mesh_.cell_region);
   for (const auto& b : mesh_.boundaries) {
     f.add(b.name.data(), b.name.size());
-    f.add(b.edges);
+    f.add(b.faces);
   }
   return f.value();
 }
 
-void Solver::save(checkpoint::Out out) const {
+template <int Dim>
+void SolverOf<Dim>::save(checkpoint::Out out) const {
   out.count("mesh_fingerprint", mesh_fingerprint());
   out.number("time", time_);
   out.count("steps", steps_);
@@ -640,7 +669,8 @@ void Solver::save(checkpoint::Out out) const {
   out.number("open_pressure", open_pressure_);
 }
 
-void Solver::load(const checkpoint::In& in) {
+template <int Dim>
+void SolverOf<Dim>::load(const checkpoint::In& in) {
   if (in.count("mesh_fingerprint") != mesh_fingerprint())
     in.refuse("written for another seepage mesh (the mesh file changed since); finish the run with that mesh, or "
               "start afresh");
@@ -675,7 +705,8 @@ void Solver::load(const checkpoint::In& in) {
   restore_state(s);
 }
 
-void Solver::restore_state(const State& s) {
+template <int Dim>
+void SolverOf<Dim>::restore_state(const State& s) {
   time_ = s.time;
   steps_ = s.steps;
   u_ = s.u;
@@ -697,5 +728,8 @@ void Solver::restore_state(const State& s) {
     assemble_conductivity();
   }
 }
+
+template class SolverOf<2>;
+template class SolverOf<3>;
 
 }  // namespace outburst::seepage

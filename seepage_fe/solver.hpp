@@ -34,7 +34,9 @@ namespace outburst::seepage {
 // Volumetric source s(x, t) in stored units per volume per second (for the gas
 // law: standard gas volume per coal volume per second). Used by manufactured
 // solutions; a scene has none.
-using SourceFunction = std::function<double(const Eigen::Vector2d&, double)>;
+template <int Dim>
+using SourceFunctionOf = std::function<double(const Eigen::Matrix<double, Dim, 1>&, double)>;
+using SourceFunction = SourceFunctionOf<2>;
 
 class StepFailure : public std::runtime_error {
  public:
@@ -48,8 +50,9 @@ struct StepReport {
   double smallest_substep = 0;
 };
 
-// Gas (or fluid) balance since t = 0, per unit depth. Volumes are standard gas
-// volumes for the gas law and fluid volumes for the linear law [m^3/m].
+// Gas (or fluid) balance since t = 0, per unit depth (3D: in all). Volumes are
+// standard gas volumes for the gas law and fluid volumes for the linear law
+// [m^3/m; 3D: m^3].
 struct Balance {
   double initial_stored = 0;
   double stored = 0;
@@ -110,12 +113,17 @@ struct Timings {
   long linear_iterations = 0;  // conjugate gradient iterations
 };
 
-class Solver {
+// In Dim = 2 (plane, per unit depth) or 3 dimensions.
+template <int Dim>
+class SolverOf {
  public:
-  Solver(Mesh mesh, Model model, Settings settings);
+  using Point = typename MeshOf<Dim>::Point;
+  static constexpr int cell_corners = MeshOf<Dim>::cell_corners;
+
+  SolverOf(MeshOf<Dim> mesh, Model model, Settings settings);
   // The sampler and the factorisation refer into the solver: it stays put.
-  Solver(const Solver&) = delete;
-  Solver& operator=(const Solver&) = delete;
+  SolverOf(const SolverOf&) = delete;
+  SolverOf& operator=(const SolverOf&) = delete;
 
   // Advance by dt; a failing step is halved and retried up to max_step_cuts times,
   // then StepFailure explains what failed and where.
@@ -126,7 +134,7 @@ class Solver {
   // ---- what a coupling driver reads and writes
   void set_conductivity(const std::vector<double>& per_cell);
   const std::vector<double>& conductivity() const { return conductivity_; }
-  void set_source(SourceFunction source) { source_ = std::move(source); }
+  void set_source(SourceFunctionOf<Dim> source) { source_ = std::move(source); }
   // A source per cell, constant over each step, in the units of SourceFunction
   // (the coupler's Biot storage term -alpha d(eps_v)/dt); added to any
   // source function. Empty: none.
@@ -142,8 +150,8 @@ class Solver {
   // Replace the initial nodal pressures p [Pa] (before the first step only).
   void set_initial_pressure(const std::vector<double>& nodal_p);
   // p [Pa] and grad p [Pa/m] at any point of the mesh; nullopt outside it.
-  std::optional<double> pressure_at(const Eigen::Vector2d& x) const;
-  std::optional<Eigen::Vector2d> pressure_gradient_at(const Eigen::Vector2d& x) const;
+  std::optional<double> pressure_at(const Point& x) const;
+  std::optional<Point> pressure_gradient_at(const Point& x) const;
 
   struct State {
     double time;
@@ -166,13 +174,13 @@ class Solver {
   void load(const checkpoint::In& in);
 
   // ---- results
-  const Mesh& mesh() const { return mesh_; }
+  const MeshOf<Dim>& mesh() const { return mesh_; }
   // Reads nodal fields of this mesh at points, and finds the cell of a point.
-  const Sampler& sampler() const { return sampler_; }
+  const SamplerOf<Dim>& sampler() const { return sampler_; }
   const Model& model() const { return model_; }
   const Eigen::VectorXd& unknown() const { return u_; }  // P (gas) or p (linear)
   std::vector<double> nodal_pressure() const;           // p [Pa]
-  std::vector<Eigen::Vector2d> cell_flux() const;       // -k grad u at cell centres [m/s]
+  std::vector<Point> cell_flux() const;                 // -k grad u at cell centres [m/s]
   const Balance& balance() const { return balance_; }
   const Timings& timings() const { return timings_; }
 
@@ -207,16 +215,16 @@ class Solver {
   bool lagged_conjugate_gradients();
   void accept_step(double h, double a0, double a2);
 
-  Mesh mesh_;
+  MeshOf<Dim> mesh_;
   Model model_;
   Settings settings_;
-  Sampler sampler_;
+  SamplerOf<Dim> sampler_;
 
   // Geometry, computed once.
-  std::vector<Eigen::Matrix4d> cell_stiffness_;  // unit conductivity
-  std::vector<Eigen::Vector4d> cell_lumped_;     // int N_a dA per cell
-  Eigen::VectorXd capacity_;                     // sum over cells of c * int N_a
-  std::vector<std::array<int, 16>> scatter_;     // cell entry -> matrix value index
+  std::vector<Eigen::Matrix<double, cell_corners, cell_corners>> cell_stiffness_;  // unit conductivity
+  std::vector<Eigen::Matrix<double, cell_corners, 1>> cell_lumped_;  // int N_a dA (3D: dV) per cell
+  Eigen::VectorXd capacity_;                                          // sum over cells of c * int N_a
+  std::vector<std::array<int, cell_corners * cell_corners>> scatter_;  // cell entry -> matrix value index
   std::vector<int> diagonal_;                    // node -> value index of (i, i)
 
   // Boundary conditions: per node, the condition index fixing it (or -1).
@@ -253,7 +261,7 @@ class Solver {
     long version = -1;
   } factor_key_;
 
-  SourceFunction source_;
+  SourceFunctionOf<Dim> source_;
   std::vector<double> cell_source_;
 
   // State.
@@ -271,5 +279,8 @@ class Solver {
   double residual_scale_ = 0;
   Timings timings_;
 };
+
+using Solver = SolverOf<2>;
+using Solver3 = SolverOf<3>;
 
 }  // namespace outburst::seepage

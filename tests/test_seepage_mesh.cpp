@@ -18,7 +18,7 @@ const fs::path source_dir = OUTBURST_SOURCE_DIR;
 double total_area(const Mesh& m) {
   double area = 0;
   for (const auto& c : m.cells) {
-    const auto integrals = q1::integrals({m.nodes[c[0]], m.nodes[c[1]], m.nodes[c[2]], m.nodes[c[3]]});
+    const auto integrals = q1::integrals(q1::Corners{m.nodes[c[0]], m.nodes[c[1]], m.nodes[c[2]], m.nodes[c[3]]});
     area += integrals.lumped.sum();
   }
   return area;
@@ -50,8 +50,8 @@ TEST_CASE("a generated mesh is graded as asked and paints regions by box", "[see
     CHECK(m.cell_region[c] == (xc > 6 ? 1 : 0));
   }
   REQUIRE(m.boundary("left"));
-  CHECK(m.boundary("left")->edges.size() == 4);
-  CHECK(m.boundary("top")->edges.size() == 20);
+  CHECK(m.boundary("left")->faces.size() == 4);
+  CHECK(m.boundary("top")->faces.size() == 20);
 }
 
 TEST_CASE("the Gmsh reader keeps quads, regions and boundaries", "[seepage][mesh]") {
@@ -62,7 +62,7 @@ TEST_CASE("the Gmsh reader keeps quads, regions and boundaries", "[seepage][mesh
   CHECK(total_area(m) == Approx(10.0).epsilon(1e-12));
   REQUIRE(m.boundary("inlet"));
   double inlet_length = 0;
-  for (const auto& e : m.boundary("inlet")->edges) inlet_length += (m.nodes[e[1]] - m.nodes[e[0]]).norm();
+  for (const auto& e : m.boundary("inlet")->faces) inlet_length += (m.nodes[e[1]] - m.nodes[e[0]]).norm();
   CHECK(inlet_length == Approx(1.0).epsilon(1e-12));
   // Every cell of region "soft" lies left of the interface x = 4.
   for (std::size_t c = 0; c < m.num_cells(); ++c)

@@ -1,0 +1,261 @@
+// The seepage solver in three dimensions (issue 21): the hexahedron's
+// integrals and the box mesh, the sampler, the manufactured solution's order,
+// drainage through a face against the 1D similarity solution, and a box one
+// cell deep that must reproduce the plane solver, balance included.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <random>
+
+#include "convergence.hpp"
+#include "seepage_fe/q1.hpp"
+#include "seepage_fixtures.hpp"
+#include "similarity.hpp"
+
+using namespace outburst;
+using namespace outburst::testing;
+
+namespace {
+
+seepage::Solver3 box_solver(seepage::Law law, Eigen::Vector3d size, std::array<int, 3> cells,
+                            seepage::Material material, std::vector<seepage::BoundaryCondition> conditions,
+                            seepage::Settings settings = {}, std::array<double, 3> grading = {1.0, 1.0, 1.0}) {
+  seepage::BoxMeshSpec spec;
+  spec.size = size;
+  spec.cells = cells;
+  spec.grading = grading;
+  seepage::Model model;
+  model.law = law;
+  model.materials = {material};
+  model.boundary_conditions = std::move(conditions);
+  return seepage::Solver3(seepage::make_box_mesh(spec), model, settings);
+}
+
+// A 3 x 3 x 3 box whose interior nodes are moved off the lattice: its cells
+// are not parallelepipeds.
+seepage::Mesh3 distorted_box() {
+  seepage::BoxMeshSpec spec;
+  spec.size = {1.5, 1.0, 1.2};
+  spec.cells = {3, 3, 3};
+  auto mesh = seepage::make_box_mesh(spec);
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> shift(-0.08, 0.08);
+  for (auto& x : mesh.nodes)
+    if (x.x() > 1e-9 && x.x() < 1.5 - 1e-9 && x.y() > 1e-9 && x.y() < 1 - 1e-9 && x.z() > 1e-9 &&
+        x.z() < 1.2 - 1e-9)
+      x += Eigen::Vector3d(shift(random), shift(random), shift(random));
+  seepage::check_mesh(mesh, "the distorted box");
+  return mesh;
+}
+
+}  // namespace
+
+TEST_CASE("a box of hexahedra: volume, face areas and orientation, and the patch test", "[seepage][3d][mesh]") {
+  seepage::BoxMeshSpec spec;
+  spec.origin = {1.0, -2.0, 0.5};
+  spec.size = {2.0, 1.0, 0.5};
+  spec.cells = {4, 3, 2};
+  spec.grading = {2.0, 1.0, 0.5};
+  const auto mesh = seepage::make_box_mesh(spec);
+  CHECK(mesh.num_nodes() == 5 * 4 * 3);
+  CHECK(mesh.num_cells() == 24);
+  double volume = 0;
+  for (std::size_t c = 0; c < mesh.num_cells(); ++c) volume += seepage::q1::integrals(mesh.corners(c)).lumped.sum();
+  CHECK(volume == Approx(1.0).epsilon(1e-12));
+  const Eigen::Vector3d centre = spec.origin + 0.5 * spec.size;
+  const std::map<std::string, double> areas{{"left", 0.5}, {"right", 0.5}, {"bottom", 1.0},
+                                            {"top", 1.0},  {"back", 2.0},  {"front", 2.0}};
+  REQUIRE(mesh.boundary_names().size() == 6);
+  for (const auto& [name, expected] : areas) {
+    INFO(name);
+    const auto* b = mesh.boundary(name);
+    REQUIRE(b);
+    double area = 0;
+    for (const auto& face : b->faces) {
+      const auto x = mesh.face_corners_of(face);
+      for (double w : seepage::q1::face_lumped(x)) area += w;
+      const Eigen::Vector3d mid = 0.25 * (x[0] + x[1] + x[2] + x[3]);
+      CHECK((x[1] - x[0]).cross(x[3] - x[0]).dot(mid - centre) > 0);  // counter-clockwise from outside
+    }
+    CHECK(area == Approx(expected).epsilon(1e-12));
+  }
+
+  // A linear field gives no residual at interior nodes of distorted cells:
+  // 2x2x2 Gauss points integrate grad N_a det J exactly on any hexahedron.
+  const auto d = distorted_box();
+  const Eigen::Vector3d a(0.7, -1.3, 2.1);
+  std::vector<double> residual(d.num_nodes(), 0.0);
+  for (std::size_t c = 0; c < d.num_cells(); ++c) {
+    const auto k = seepage::q1::integrals(d.corners(c)).stiffness;
+    for (int i = 0; i < 8; ++i)
+      for (int j = 0; j < 8; ++j) residual[d.cells[c][i]] += k(i, j) * (1 + a.dot(d.nodes[d.cells[c][j]]));
+  }
+  int interior = 0;
+  for (int k = 1; k < 3; ++k)
+    for (int j = 1; j < 3; ++j)
+      for (int i = 1; i < 3; ++i, ++interior) CHECK(std::abs(residual[(k * 4 + j) * 4 + i]) < 1e-13);
+  CHECK(interior == 8);
+}
+
+TEST_CASE("the 3D sampler reads a linear field exactly inside the box and nothing outside it",
+          "[seepage][3d][sampling]") {
+  const Eigen::Vector3d a(2.0, -3.0, 0.5);
+  for (const bool distorted : {false, true}) {
+    seepage::BoxMeshSpec spec;
+    spec.size = {1.5, 1.0, 1.2};
+    spec.cells = {3, 3, 3};
+    spec.grading = {3.0, 1.0, 0.4};
+    const auto mesh = distorted ? distorted_box() : seepage::make_box_mesh(spec);
+    const seepage::SamplerOf<3> sampler(mesh);
+    Eigen::VectorXd u(static_cast<Eigen::Index>(mesh.num_nodes()));
+    for (std::size_t i = 0; i < mesh.num_nodes(); ++i) u[i] = 1 + a.dot(mesh.nodes[i]);
+    std::mt19937 random(3);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    int hint = -1;
+    INFO((distorted ? "distorted" : "graded"));
+    for (int k = 0; k < 300; ++k) {
+      const Eigen::Vector3d x(1.5 * unit(random), unit(random), 1.2 * unit(random));
+      const auto s = sampler.sample(u, x, &hint);
+      REQUIRE(s);
+      CHECK(s->value == Approx(1 + a.dot(x)).epsilon(1e-12));
+      CHECK((s->gradient - a).norm() < 1e-11);
+    }
+    CHECK_FALSE(sampler.sample(u, Eigen::Vector3d(0.5, 0.5, 1.3)));
+    CHECK_FALSE(sampler.sample(u, Eigen::Vector3d(-0.01, 0.5, 0.5)));
+    CHECK(sampler.cell_of(Eigen::Vector3d(1.6, 0.5, 0.5)) == -1);
+  }
+}
+
+namespace {
+
+// P = 2 + sin(pi x) sin(pi y) sin(pi z) g(t) on the unit cube, P = 2 on its
+// faces: the 2D manufactured solution (seepage_manufactured.hpp) one
+// dimension up.
+namespace cube {
+constexpr double pi = 3.14159265358979323846;
+constexpr double A = 2.0, lambda = 0.1;
+double g(double t) { return 0.5 * (1 + std::cos(3 * t)); }
+double dg(double t) { return -1.5 * std::sin(3 * t); }
+double bump(const Eigen::Vector3d& x) { return std::sin(pi * x.x()) * std::sin(pi * x.y()) * std::sin(pi * x.z()); }
+double exact(const Eigen::Vector3d& x, double t) { return 2 + bump(x) * g(t); }
+double source(const Eigen::Vector3d& x, double t) {
+  const double s = bump(x), P = 2 + s * g(t);
+  return A * 0.25 * std::pow(P, -0.75) * s * dg(t) + lambda * 3 * pi * pi * s * g(t);
+}
+
+// || P_h - P ||_L2 with 3x3x3 Gauss points per cell.
+double l2_error(const seepage::Solver3& s, double t) {
+  const double gp[3] = {-std::sqrt(0.6), 0.0, std::sqrt(0.6)}, gw[3] = {5.0 / 9, 8.0 / 9, 5.0 / 9};
+  double sum = 0;
+  const auto& m = s.mesh();
+  for (std::size_t c = 0; c < m.num_cells(); ++c) {
+    const auto x = m.corners(c);
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        for (int k = 0; k < 3; ++k) {
+          const auto p = seepage::q1::evaluate(x, Eigen::Vector3d(gp[i], gp[j], gp[k]));
+          double uh = 0;
+          Eigen::Vector3d at = Eigen::Vector3d::Zero();
+          for (int a = 0; a < 8; ++a) {
+            uh += p.n[a] * s.unknown()[m.cells[c][a]];
+            at += p.n[a] * x[a];
+          }
+          sum += gw[i] * gw[j] * gw[k] * p.det_j * std::pow(uh - exact(at, t), 2);
+        }
+  }
+  return std::sqrt(sum);
+}
+}  // namespace cube
+
+}  // namespace
+
+TEST_CASE("with a manufactured gas solution Q1 hexahedra converge at second order", "[seepage][3d][mms]") {
+  const double T = 0.1;
+  const double face = std::sqrt(2.0);
+  std::vector<ConvergenceRow> rows;
+  for (int n : {4, 8, 16}) {
+    std::vector<seepage::BoundaryCondition> faces;
+    for (const char* name : {"left", "right", "bottom", "top", "back", "front"})
+      faces.push_back(fixed_pressure(name, face));
+    auto s = box_solver(seepage::Law::gas, {1, 1, 1}, {n, n, n}, {cube::lambda, cube::A, face}, faces);
+    s.set_source(cube::source);
+    std::vector<double> p0;
+    for (const auto& x : s.mesh().nodes) p0.push_back(std::sqrt(cube::exact(x, 0.0)));
+    s.set_initial_pressure(p0);
+    for (int k = 0; k < 20; ++k) s.advance(T / 20);  // BDF2, dt = 5e-3: time error below the spatial
+    rows.push_back({1.0 / n, cube::l2_error(s, T)});
+  }
+  print_convergence("seepage MMS in 3D, space (BDF2, dt = 5e-3)", "h", rows);
+  for (double order : observed_orders(rows)) CHECK(order == Approx(2.0).margin(0.15));
+}
+
+TEST_CASE("drainage of a box through one face follows the self-similar solution", "[seepage][3d][drainage]") {
+  // The plane test's strip (test_seepage_drainage.cpp) as a 10 x 1 x 1 box:
+  // the closed faces leave the flow one-dimensional.
+  const double ratio = 1.0 / 30;
+  const DrainageSimilarity exact(ratio * ratio);
+  std::vector<ConvergenceRow> profile, emission;
+  for (int cells : {50, 100}) {
+    auto s = box_solver(seepage::Law::gas, {10, 1, 1}, {cells, 1, 1}, {1.0, 4.0, 1.0},
+                        {fixed_pressure("left", ratio)}, {}, {20.0, 1.0, 1.0});
+    double dt = 1e-4 / (cells * cells), t = 0;
+    const double growth = 1 + 4.0 / cells;
+    while (t < 1) {
+      const double h = std::min(dt, 1 - t);
+      s.advance(h);
+      t += h;
+      dt *= growth;
+    }
+    double worst = 0;
+    for (std::size_t i = 0; i < s.mesh().num_nodes(); ++i)
+      worst = std::max(worst, std::abs(s.unknown()[i] - exact.f(s.mesh().nodes[i].x())));
+    const double emitted_exact = 2 * exact.slope_at_face();  // per unit face area, the face 1 x 1
+    profile.push_back({10.0 / cells, worst});
+    emission.push_back({10.0 / cells, std::abs(s.balance().total_outflow() - emitted_exact) / emitted_exact});
+    CHECK(std::abs(s.balance().error()) < 1e-10 * s.balance().initial_stored);
+  }
+  print_convergence("3D drainage p_f/p0 = 1/30: max |P_h - P| / P0", "h (mean)", profile);
+  print_convergence("3D drainage p_f/p0 = 1/30: emission, relative", "h (mean)", emission);
+  CHECK(profile.back().error < 2e-4);
+  CHECK(emission.back().error < 3e-3);
+  for (double order : observed_orders(profile)) CHECK(order > 1.8);
+  for (double order : observed_orders(emission)) CHECK(order > 1.5);
+}
+
+TEST_CASE("a box one cell deep with closed ends reproduces the plane solver", "[seepage][3d]") {
+  // z-invariant: each hexahedron's stiffness and storage are its quadrilateral's
+  // times half the depth at either end, so the nodal values are the plane
+  // solver's and the balance its per-metre figures times the depth.
+  const double depth = 0.3;
+  const seepage::Material coal{1e-17 / 1.1e-5, 2e-3, 3e6};
+  const seepage::BoundaryCondition face{"left", seepage::BoundaryCondition::Type::pressure,
+                                        TimeFunction({{0.0, 3e6}, {3600.0, 1e5}})};
+  const seepage::BoundaryCondition inflow{"right", seepage::BoundaryCondition::Type::flux, TimeFunction(2e-7)};
+  auto plane = rectangle_solver(seepage::Law::gas, {10, 2}, {20, 4}, coal, {face, inflow}, {}, {5.0, 1.0});
+  auto box = box_solver(seepage::Law::gas, {10, 2, depth}, {20, 4, 1}, coal, {face, inflow}, {}, {5.0, 1.0, 1.0});
+  double dt = 60;
+  for (int k = 0; k < 20; ++k, dt *= 1.3) {
+    plane.advance(dt);
+    box.advance(dt);
+  }
+  const std::size_t layer = plane.mesh().num_nodes();
+  REQUIRE(box.mesh().num_nodes() == 2 * layer);
+  double worst = 0;
+  for (std::size_t i = 0; i < layer; ++i) {
+    REQUIRE((box.mesh().nodes[i].head<2>() - plane.mesh().nodes[i]).norm() < 1e-12);
+    for (std::size_t at : {i, i + layer}) worst = std::max(worst, std::abs(box.unknown()[at] - plane.unknown()[i]));
+  }
+  CHECK(worst < 1e-9 * plane.unknown().lpNorm<Eigen::Infinity>());
+  CHECK(box.balance().total_outflow() == Approx(depth * plane.balance().total_outflow()).epsilon(1e-9));
+  CHECK(box.balance().stored == Approx(depth * plane.balance().stored).epsilon(1e-12));
+  // Closed to Newton's tolerance, and open by the plane solver's amount.
+  CHECK(std::abs(box.balance().error()) < 1e-8 * box.balance().initial_stored);
+  CHECK(std::abs(box.balance().error() - depth * plane.balance().error()) < 1e-12 * box.balance().initial_stored);
+  // The sampler and the cell fluxes agree too.
+  const Eigen::Vector2d x(3.3, 0.7);
+  const auto p2 = plane.pressure_gradient_at(x);
+  const auto p3 = box.pressure_gradient_at(Eigen::Vector3d(x.x(), x.y(), 0.4 * depth));
+  REQUIRE((p2 && p3));
+  CHECK((p3->head<2>() - *p2).norm() < 1e-8 * p2->norm());
+  CHECK(std::abs((*p3)[2]) < 1e-8 * p2->norm());
+}
