@@ -5,7 +5,7 @@
 // Problem (as issue 2 fixed it): unit square, A = 2, lambda = 0.1, P0 = 9
 // (p0 = 3), the left side drained to p = 1, backward Euler, Newton, steps of
 // --time-step (1e-3 by default). --mesh adds Gmsh meshes: every region that material, the mesh's
-// first boundary drained.
+// first boundary drained. --cube adds the unit cube in hexahedra, its left face drained.
 //
 // The machine may be shared: contenders alternate within each round and each
 // keeps its best round, so a burst of load elsewhere costs a round, not a row.
@@ -34,13 +34,16 @@ double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-struct Case {
-  std::string mesh_name;  // "square" or the Gmsh file's name
-  seepage::Mesh mesh;
+template <int Dim>
+struct CaseOf {
+  std::string mesh_name;  // "square", "cube" or the Gmsh file's name
+  seepage::MeshOf<Dim> mesh;
   seepage::Model model;
 };
+using Case = CaseOf<2>;
 
-seepage::Model benchmark_model(const seepage::Mesh& mesh) {
+template <int Dim>
+seepage::Model benchmark_model(const seepage::MeshOf<Dim>& mesh) {
   seepage::Model model;
   model.law = seepage::Law::gas;
   model.materials.assign(mesh.region_names.size(), {0.1, 2.0, 3.0});
@@ -58,6 +61,14 @@ Case square(int cells) {
   return c;
 }
 
+CaseOf<3> cube(int cells) {
+  seepage::BoxMeshSpec spec;
+  spec.cells = {cells, cells, cells};
+  CaseOf<3> c{"cube", seepage::make_box_mesh(spec), {}};
+  c.model = benchmark_model(c.mesh);
+  return c;
+}
+
 Case gmsh(const std::string& path) {
   Case c{path.substr(path.find_last_of('/') + 1), seepage::read_gmsh(path, 1.0), {}};
   if (c.mesh.boundary_names().empty()) throw std::runtime_error(path + ": the mesh names no boundary to drain");
@@ -67,10 +78,11 @@ Case gmsh(const std::string& path) {
 
 // ---- the solver's Newton iterations, one contender per linear solver
 
+template <int Dim>
 struct Contender {
   std::string linear_solver;
-  std::unique_ptr<seepage::Solver> solver;
-  seepage::Solver::State start;  // every round times the step from here
+  std::unique_ptr<seepage::SolverOf<Dim>> solver;
+  typename seepage::SolverOf<Dim>::State start;  // every round times the step from here
   seepage::Timings best{};  // the round with the cheapest Newton iteration
   double best_per_iteration = std::numeric_limits<double>::infinity();
   double difference = 0;  // max |u - u_reference| / max |u_reference| after a round
@@ -93,15 +105,16 @@ seepage::LinearSolver linear_solver(const std::string& name) {
   return seepage::LinearSolver::direct;
 }
 
-void newton_rows(const Case& c, const std::vector<std::string>& linear_solvers, double dt, double cg_tolerance,
+template <int Dim>
+void newton_rows(const CaseOf<Dim>& c, const std::vector<std::string>& linear_solvers, double dt, double cg_tolerance,
                  int rounds, int steps, std::FILE* csv) {
-  std::vector<Contender> contenders;
+  std::vector<Contender<Dim>> contenders;
   for (const auto& name : linear_solvers) {
     seepage::Settings settings;
     settings.scheme = seepage::TimeScheme::backward_euler;
     settings.linear_solver = linear_solver(name);
     settings.cg_tolerance = cg_tolerance;
-    contenders.push_back({name, std::make_unique<seepage::Solver>(c.mesh, c.model, settings), {}});
+    contenders.push_back({name, std::make_unique<seepage::SolverOf<Dim>>(c.mesh, c.model, settings), {}});
     contenders.back().solver->advance(dt);  // first touch of every array
     contenders.back().start = contenders.back().solver->save_state();
   }
@@ -161,10 +174,11 @@ struct Variant {
   double best = std::numeric_limits<double>::infinity();
 };
 
-void ordering_rows(const Case& c, double dt, long simplicial_up_to, int rounds, std::FILE* csv) {
+template <int Dim>
+void ordering_rows(const CaseOf<Dim>& c, double dt, long simplicial_up_to, int rounds, std::FILE* csv) {
   seepage::Settings settings;
   settings.scheme = seepage::TimeScheme::backward_euler;
-  seepage::Solver solver(c.mesh, c.model, settings);
+  seepage::SolverOf<Dim> solver(c.mesh, c.model, settings);
   solver.advance(dt);  // the Jacobian of a Newton iteration
   const auto& j = solver.jacobian();
   const long unknowns = j.rows();
@@ -226,7 +240,7 @@ int main(int argc, char** argv) {
   CLI::App app("The seepage solver's Newton iterations under each linear solver, and CHOLMOD's factorisation of "
                "their Jacobian under each mode and ordering",
                "seepage-benchmark");
-  std::vector<int> sides{99, 315, 999};
+  std::vector<int> sides, cube_sides;
   std::vector<std::string> meshes, linear_solvers{"direct", "cg"};
   std::string csv_path, orderings_path;
   std::vector<double> time_steps{1e-3};
@@ -234,9 +248,13 @@ int main(int argc, char** argv) {
   int rounds = 3, steps = 1;
   long simplicial_up_to = std::numeric_limits<long>::max();
   bool no_newton = false, no_orderings = false;
-  app.add_option("cells", sides, "cells per side of the unit square, one case each (unknowns: (n + 1)^2)")
-      ->check(CLI::Range(2, 4000))
-      ->capture_default_str();
+  app.add_option("cells", sides,
+                 "cells per side of the unit square, one case each (unknowns: (n + 1)^2); without these, --mesh "
+                 "and --cube: 99 315 999")
+      ->check(CLI::Range(2, 4000));
+  app.add_option("--cube", cube_sides, "cells per side of the unit cube in hexahedra, one case each, after the "
+                                      "meshes (unknowns: (n + 1)^3)")
+      ->check(CLI::Range(1, 200));
   app.add_option("--mesh", meshes, "a Gmsh MSH 4.1 mesh, one case each, after the squares")->check(CLI::ExistingFile);
   app.add_option("--csv", csv_path,
                  "write the Newton iterations' rows to this CSV (seepage_fe/benchmark/crossover.csv is one)");
@@ -273,9 +291,12 @@ int main(int argc, char** argv) {
                                         "cg_iterations,over_reference,difference");
     std::FILE* orderings = open_csv(orderings_path, "unknowns,mesh,mode,ordering,analyse_s,factor_solve_s,"
                                                     "factor_nonzeros,flops,over_fastest,chosen");
+    if (sides.empty() && meshes.empty() && cube_sides.empty()) sides = {99, 315, 999};
     std::vector<Case> cases;
     for (int n : sides) cases.push_back(square(n));
     for (const auto& m : meshes) cases.push_back(gmsh(m));
+    std::vector<CaseOf<3>> cubes;
+    for (int n : cube_sides) cubes.push_back(cube(n));
     std::printf("BLAS: %s; %d rounds, best kept\n", blas::description().c_str(), rounds);
     if (!no_newton) {
       std::printf("\nPer Newton iteration [s] (other: residuals, Jacobian values, line search, bookkeeping; differs: max |u - u_first| / max |u_first| after the round)\n");
@@ -283,12 +304,15 @@ int main(int argc, char** argv) {
                   "method", "Newton", "per it.", "factor", "solve", "other", "cg its", "/ first", "differs");
       for (const auto& c : cases)
         for (double dt : time_steps) newton_rows(c, linear_solvers, dt, cg_tolerance, rounds, steps, csv);
+      for (const auto& c : cubes)
+        for (double dt : time_steps) newton_rows(c, linear_solvers, dt, cg_tolerance, rounds, steps, csv);
     }
     if (!no_orderings) {
       std::printf("\nCHOLMOD factor-and-solve of the Jacobian\n");
       std::printf("%9s %-14s %-28s %9s %10s %10s %10s %8s\n", "unknowns", "mesh", "mode/ordering", "analyse",
                   "factor+solve", "nnz(L)", "flops", "/ best");
       for (const auto& c : cases) ordering_rows(c, time_steps.front(), simplicial_up_to, rounds, orderings);
+      for (const auto& c : cubes) ordering_rows(c, time_steps.front(), simplicial_up_to, rounds, orderings);
     }
     for (std::FILE* f : {csv, orderings})
       if (f && std::fclose(f) != 0) throw std::runtime_error("a CSV could not be written in full");
