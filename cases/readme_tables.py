@@ -514,6 +514,18 @@ def seepage_linear_solvers(rows):
     return lines
 
 
+@block("seepage orderings in 3d", "seepage_fe/benchmark/orderings_3d.csv")
+def seepage_orderings_3d(rows):
+    """The same on the unit cube in hexahedra."""
+    return seepage_orderings(rows)
+
+
+@block("seepage linear solvers in 3d", "seepage_fe/benchmark/crossover_3d.csv")
+def seepage_linear_solvers_3d(rows):
+    """The same on the unit cube in hexahedra."""
+    return seepage_linear_solvers(rows)
+
+
 @block("seepage against fenicsx", "seepage_fe/benchmark/fenicsx.csv")
 def seepage_against_fenicsx(rows):
     """Per Newton iteration, ours under each linear solver and FEniCSx's, and how far each answer lies from ours, direct."""

@@ -30,17 +30,19 @@ class ScopedTimer {
 
 }  // namespace
 
-// The fastest numeric factorisation by size, read from
-// seepage_fe/benchmark/orderings.csv (`seepage-benchmark --orderings-csv`, on
-// the unit square and the outburst's meshes; the README tables it). Below
-// about 5000 unknowns simplicial: its loops beat supernodal's BLAS calls, and
-// the orderings tie, so AMD, the quickest to compute. From there supernodal
-// with CHOLMOD's nested dissection: the fewest flops (to 1 %) and the fastest
-// or within 11 % of it (the noise) at every size to 1e6. Its analysis, the slowest
+// The fastest numeric factorisation by size and dimension, read from
+// seepage_fe/benchmark/orderings.csv and orderings_3d.csv
+// (`seepage-benchmark --orderings-csv`, on the unit square, the outburst's
+// meshes and the unit cube; the README tables them). In 2D below about 5000
+// unknowns simplicial: its loops beat supernodal's BLAS calls, and the
+// orderings tie, so AMD, the quickest to compute. From there, and in 3D at
+// every size (a hexahedron couples 27 nodes, and the fronts are wide from the
+// start), supernodal with CHOLMOD's nested dissection: the fewest flops (to
+// 1 %) and the fastest or within the noise of it. Its analysis, the slowest
 // (seconds at 1e6), is done once per run.
-Factorisation factorisation_for(std::size_t unknowns) {
+Factorisation factorisation_for(std::size_t unknowns, int dim) {
   using F = Factorisation;
-  if (unknowns < 5000) return {F::Mode::simplicial, F::Ordering::amd};
+  if (dim == 2 && unknowns < 5000) return {F::Mode::simplicial, F::Ordering::amd};
   return {F::Mode::supernodal, F::Ordering::nesdis};
 }
 
@@ -168,7 +170,7 @@ void SolverOf<Dim>::setup_system() {
   assemble_conductivity();
   blas::set_threads_for(static_cast<long>(n));
   if (settings_.linear_solver != LinearSolver::cg) {
-    factorisation_ = factorisation_for(n);
+    factorisation_ = factorisation_for(n, Dim);
     configure(factor_, factorisation_);
     factor_.analyzePattern(jacobian_);
   } else {

@@ -74,7 +74,7 @@ struct Factorisation {
   std::string name() const;  // "supernodal/nesdis"
 };
 // The one the solver picks for a Jacobian of this many unknowns.
-Factorisation factorisation_for(std::size_t unknowns);
+Factorisation factorisation_for(std::size_t unknowns, int dim);
 using Cholmod = Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::Lower>;
 // Sets the mode and ordering, before analyzePattern.
 void configure(Cholmod& factor, Factorisation f);

@@ -259,3 +259,13 @@ TEST_CASE("a box one cell deep with closed ends reproduces the plane solver", "[
   CHECK((p3->head<2>() - *p2).norm() < 1e-8 * p2->norm());
   CHECK(std::abs((*p3)[2]) < 1e-8 * p2->norm());
 }
+
+TEST_CASE("CHOLMOD factorises 3D meshes supernodally at every size, plane ones simplicially when small",
+          "[seepage][3d][direct]") {
+  // As measured (seepage_fe/benchmark/orderings.csv and orderings_3d.csv).
+  const seepage::Material m{0.1, 2.0, 3.0};
+  auto box = box_solver(seepage::Law::gas, {1, 1, 1}, {4, 4, 4}, m, {fixed_pressure("left", 1.0)});
+  auto plane = rectangle_solver(seepage::Law::gas, {1, 1}, {4, 4}, m, {fixed_pressure("left", 1.0)});
+  CHECK(box.factorisation().name() == "supernodal/nesdis");
+  CHECK(plane.factorisation().name() == "simplicial/amd");
+}

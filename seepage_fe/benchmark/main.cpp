@@ -162,6 +162,7 @@ void newton_rows(const CaseOf<Dim>& c, const std::vector<std::string>& linear_so
                    k.best_per_iteration, t.factorization / its, t.solve / its,
                    (t.total_step - t.factorization - t.solve) / its, cg_iterations, k.best_per_iteration / direct,
                    k.difference);
+    if (csv) std::fflush(csv);  // a stopped run keeps its rows
   }
 }
 
@@ -212,7 +213,7 @@ void ordering_rows(const CaseOf<Dim>& c, double dt, long simplicial_up_to, int r
     }
   double fastest = std::numeric_limits<double>::infinity();
   for (const auto& v : variants) fastest = std::min(fastest, v.best);
-  const std::string chosen = seepage::factorisation_for(static_cast<std::size_t>(unknowns)).name();
+  const std::string chosen = seepage::factorisation_for(static_cast<std::size_t>(unknowns), Dim).name();
   for (const auto& v : variants) {
     const std::string name = v.f.name();
     std::printf("%9ld %-14s %-28s %9.4f %10.5f %10.3g %10.3g %8.3f%s\n", unknowns, c.mesh_name.c_str(),
@@ -222,6 +223,7 @@ void ordering_rows(const CaseOf<Dim>& c, double dt, long simplicial_up_to, int r
       std::fprintf(csv, "%ld,%s,%s,%s,%.6g,%.6g,%.6g,%.6g,%.4f,%d\n", unknowns, c.mesh_name.c_str(),
                    name.substr(0, name.find('/')).c_str(), name.substr(name.find('/') + 1).c_str(), v.analyse_s,
                    v.best, v.factor_nonzeros, v.flops, v.best / fastest, name == chosen ? 1 : 0);
+    if (csv) std::fflush(csv);
   }
   std::fflush(stdout);
 }
