@@ -24,16 +24,7 @@ struct DrainageResult {
 DrainageResult drain(double face_ratio, const DrainageSimilarity& exact, int cells) {
   auto s = rectangle_solver(seepage::Law::gas, {10, 1}, {cells, 1}, {1.0, 4.0, 1.0},
                             {fixed_pressure("left", face_ratio)}, {}, {20.0, 1.0});
-  // Geometric steps from a tiny first one (the solution is self-similar in
-  // sqrt(t)), refined with the mesh: the step ratio - 1 halves as h halves.
-  double dt = 1e-4 / (cells * cells), t = 0;
-  const double growth = 1 + 4.0 / cells;
-  while (t < 1) {
-    const double h = std::min(dt, 1 - t);
-    s.advance(h);
-    t += h;
-    dt *= growth;
-  }
+  drain_to_unit_time(s, cells);
   double profile_error = 0;
   for (std::size_t i = 0; i < s.mesh().num_nodes(); ++i)
     profile_error = std::max(profile_error, std::abs(s.unknown()[i] - exact.f(s.mesh().nodes[i].x())));
