@@ -53,17 +53,19 @@ CellLocatorOf<Dim>::CellLocatorOf(const MeshOf<Dim>& mesh) : mesh_(mesh) {
     along_[0] = static_cast<int>(std::clamp(std::sqrt(cells * aspect), 1.0, cells));
     along_[1] = std::max(1, static_cast<int>(cells / along_[0]));
   } else {
-    // Cubes of the volume per cell, each axis at least one bucket, the
-    // total at most one per cell.
+    // Cubes of the volume per cell, each axis at least one bucket. An axis
+    // held at one bucket (a thin slab) leaves the others too many: the
+    // longest gives them back until there is at most one per cell.
     const double side = std::cbrt(extent.prod() / cells);
     double total = 1;
     for (int d = 0; d < Dim; ++d) {
       along_[d] = static_cast<int>(std::clamp(extent[d] / side, 1.0, cells));
       total *= along_[d];
     }
-    for (int d = 0; total > cells && d < Dim; ++d) {
+    while (total > cells) {
+      const int d = static_cast<int>(std::max_element(along_.begin(), along_.end()) - along_.begin());
       total /= along_[d];
-      along_[d] = std::max(1, static_cast<int>(along_[d] * std::cbrt(cells / (total * along_[d]))));
+      along_[d] = std::max(1, static_cast<int>(cells / total));
       total *= along_[d];
     }
   }

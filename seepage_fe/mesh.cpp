@@ -457,18 +457,23 @@ Mesh3 make_box_mesh(const BoxMeshSpec& spec) {
 }
 
 void check_mesh(const Mesh3& mesh, const std::string& source) {
-  // A trilinear map is invertible if its Jacobian is positive at the corners
-  // (for the hexahedra meshers make); the corners' edge triples give it.
+  // A positive Jacobian at the corners and at the Gauss points the integrals
+  // use: not a proof that a trilinear map is invertible (a badly twisted
+  // hexahedron can pass), but it refuses inverted and collapsed cells, and
+  // every point the solver evaluates has a positive volume.
   for (std::size_t c = 0; c < mesh.cells.size(); ++c) {
     const auto x = mesh.corners(c);
+    const auto refuse = [&](const std::string& where) {
+      throw std::runtime_error(fmt::format(
+          "{}: hexahedron {} (first corner at ({:g}, {:g}, {:g})) is degenerate or inverted at {}", source, c,
+          x[0].x(), x[0].y(), x[0].z(), where));
+    };
     for (int a = 0; a < 8; ++a) {
       const Eigen::Vector3d r(q1::hex_corner[a][0], q1::hex_corner[a][1], q1::hex_corner[a][2]);
-      const double det = q1::evaluate(x, r).det_j;
-      if (!(det > 0))
-        throw std::runtime_error(fmt::format(
-            "{}: hexahedron {} (first corner at ({:g}, {:g}, {:g})) is degenerate or inverted at its corner {}",
-            source, c, x[0].x(), x[0].y(), x[0].z(), a));
+      if (!(q1::evaluate(x, r).det_j > 0)) refuse(fmt::format("its corner {}", a));
     }
+    for (const auto& g : q1::gauss2_points3())
+      if (!(q1::evaluate(x, g).det_j > 0)) refuse("a Gauss point");
   }
 }
 

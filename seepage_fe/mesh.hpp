@@ -3,9 +3,10 @@
 // geometric grading) or unstructured quads read from Gmsh; generated boxes of
 // hexahedra in 3D.
 //
-// Regions (cell sets with their own material) and boundaries (edge sets where
-// conditions apply) are named: "left", "right", "bottom", "top" on generated
-// meshes, Gmsh physical group names on read ones.
+// Regions (cell sets with their own material) and boundaries (sets of faces,
+// edges in 2D, where conditions apply) are named: "left", "right", "bottom",
+// "top" (and "back", "front" on boxes) on generated meshes, Gmsh physical
+// group names on read ones.
 
 #include <array>
 #include <filesystem>

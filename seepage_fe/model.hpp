@@ -68,9 +68,11 @@ struct Settings {
   int max_step_cuts = 12;    // halvings of a failing step before giving up
   // The Newton systems: CHOLMOD; conjugate gradients preconditioned by an
   // incomplete Cholesky factor; or (lagged) conjugate gradients preconditioned
-  // by CHOLMOD's factor of an earlier Jacobian, renewed when they need more than
-  // lag_max_iterations. Both iterative ones solve to
-  // ||J du + r|| <= cg_tolerance ||r||.
+  // by CHOLMOD's factor of an earlier Jacobian, renewed at the next iteration
+  // once they use more than half of lag_max_iterations, and at once (solving
+  // directly) when they do not converge within it. Both iterative ones solve
+  // to ||J du + r|| <= cg_tolerance ||r||. The linear law's Jacobian does not
+  // move: lagged solves it as direct does.
   LinearSolver linear_solver = LinearSolver::direct;
   double cg_tolerance = 1e-8;
   int cg_max_iterations = 5000;  // beyond them the step is cut

@@ -141,8 +141,9 @@ void read_settings(const scene::Table& s, Setup& setup) {
   if (st.linear_solver == LinearSolver::lagged)
     st.lag_max_iterations = s.integer<int>(
         {"lag_max_iterations",
-         "conjugate gradient iterations on an earlier Jacobian's factor before it is renewed (a renewal "
-         "costs about as many triangular solves as the factorisation's flops over the solve's)",
+         "conjugate gradient iterations allowed on an earlier Jacobian's factor: past half of them the factor "
+         "is renewed at the next Newton iteration, past all of them at once (the linear law ignores it: its "
+         "Jacobian does not move)",
          "10", Range::between(1, 1000)});
   else if (s.has("lag_max_iterations"))
     s.fail("lag_max_iterations", "applies to the lagged factorisation only: set seepage.linear_solver = \"lagged\"");

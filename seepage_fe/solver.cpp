@@ -547,10 +547,16 @@ bool SolverOf<Dim>::lagged_conjugate_gradients() {
   lagged_cg_.compute(jacobian_);
   delta_ = lagged_cg_.solve(-r_);
   timings_.linear_iterations += lagged_cg_.iterations();
-  if (lagged_cg_.info() != Eigen::Success || !delta_.allFinite()) return false;
+  if (lagged_cg_.info() != Eigen::Success || !delta_.allFinite()) {
+    ++timings_.lagged_fallbacks;
+    return false;
+  }
   // Half the allowance spent: the next iteration renews the factor rather than
   // spend as much again.
-  if (2 * lagged_cg_.iterations() > settings_.lag_max_iterations) factor_key_ = {};
+  if (2 * lagged_cg_.iterations() > settings_.lag_max_iterations) {
+    factor_key_ = {};
+    ++timings_.lagged_renewals;
+  }
   return true;
 }
 

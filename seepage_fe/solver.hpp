@@ -111,6 +111,8 @@ struct Timings {
   long nonlinear_iterations = 0;
   long residual_evaluations = 0;
   long linear_iterations = 0;  // conjugate gradient iterations
+  long lagged_renewals = 0;    // lagged factors renewed for their iterations: past half the allowance
+  long lagged_fallbacks = 0;   // ... and past all of it (solved directly)
 };
 
 // In Dim = 2 (plane, per unit depth) or 3 dimensions.

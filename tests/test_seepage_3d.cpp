@@ -50,6 +50,19 @@ seepage::Mesh3 distorted_box() {
 
 }  // namespace
 
+TEST_CASE("the 3D cell locator keeps at most one bucket per cell on thin slabs", "[seepage][3d][sampling]") {
+  for (const double thickness : {1e-6, 1e-4, 3e-22}) {
+    seepage::BoxMeshSpec spec;
+    spec.size = {1.0, 1.0, thickness};
+    spec.cells = {100, 100, 1};
+    const auto mesh = seepage::make_box_mesh(spec);
+    const seepage::CellLocatorOf<3> locator(mesh);
+    INFO("thickness " << thickness);
+    CHECK(locator.buckets() <= mesh.num_cells());
+    CHECK(locator.locate(Eigen::Vector3d(0.505, 0.305, 0.5 * thickness)));
+  }
+}
+
 TEST_CASE("a box of hexahedra: volume, face areas and orientation, and the patch test", "[seepage][3d][mesh]") {
   seepage::BoxMeshSpec spec;
   spec.origin = {1.0, -2.0, 0.5};
@@ -119,6 +132,16 @@ TEST_CASE("the 3D sampler reads a linear field exactly inside the box and nothin
       REQUIRE(s);
       CHECK(s->value == Approx(1 + a.dot(x)).epsilon(1e-12));
       CHECK((s->gradient - a).norm() < 1e-11);
+    }
+    // Boxes take the parallelepipeds' path, distorted cells Newton's.
+    const seepage::CellLocatorOf<3> locator(mesh);
+    for (std::size_t c = 0; c < mesh.num_cells(); ++c) {
+      Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+      for (const auto& corner : mesh.corners(c)) centre += 0.125 * corner;
+      int hint = static_cast<int>(c);
+      const auto hit = locator.locate(centre, &hint);
+      REQUIRE(hit);
+      CHECK((hit->inverse_jacobian != nullptr) == !distorted);
     }
     CHECK_FALSE(sampler.sample(u, Eigen::Vector3d(0.5, 0.5, 1.3)));
     CHECK_FALSE(sampler.sample(u, Eigen::Vector3d(-0.01, 0.5, 0.5)));
@@ -216,9 +239,11 @@ TEST_CASE("drainage of a box through one face follows the self-similar solution"
 }
 
 TEST_CASE("a box one cell deep with closed ends reproduces the plane solver", "[seepage][3d]") {
-  // z-invariant: each hexahedron's stiffness and storage are its quadrilateral's
-  // times half the depth at either end, so the nodal values are the plane
-  // solver's and the balance its per-metre figures times the depth.
+  // For fields that do not vary along z the term of a hexahedron's stiffness
+  // coupling its two layers vanishes, and what is left, like its lumped
+  // storage, is its quadrilateral's times half the depth at either end: the
+  // nodal values are the plane solver's, the balance its per-metre figures
+  // times the depth.
   const double depth = 0.3;
   const seepage::Material coal{1e-17 / 1.1e-5, 2e-3, 3e6};
   const seepage::BoundaryCondition face{"left", seepage::BoundaryCondition::Type::pressure,

@@ -94,39 +94,52 @@ TEST_CASE("with conjugate gradients stored gas plus what crossed the boundary st
 TEST_CASE("the lagged solver renews its factor when the conductivity changes or its iterations grow",
           "[seepage][lagged]") {
   const seepage::Material coal{1e-17, 2e-3, 3e6};
-  const auto solver = [&](int lag_max_iterations) {
-    seepage::Settings settings = with(seepage::LinearSolver::lagged);
-    settings.lag_max_iterations = lag_max_iterations;
+  const auto solver = [&](seepage::Settings settings) {
     return rectangle_solver(seepage::Law::gas, {10, 1}, {40, 4}, coal, {fixed_pressure("left", 1e5)}, settings);
   };
-  auto lagged = solver(10);
-  auto direct = rectangle_solver(seepage::Law::gas, {10, 1}, {40, 4}, coal, {fixed_pressure("left", 1e5)});
+  const auto lagged_with = [&](int lag_max_iterations) {
+    seepage::Settings settings = with(seepage::LinearSolver::lagged);
+    settings.lag_max_iterations = lag_max_iterations;
+    return solver(settings);
+  };
+  const auto agrees = [](const auto& a, const auto& b) {
+    return (a.unknown() - b.unknown()).template lpNorm<Eigen::Infinity>() <
+           1e-9 * b.unknown().template lpNorm<Eigen::Infinity>();
+  };
+  auto direct = solver({});
+  auto kept = lagged_with(1000);
   for (int k = 0; k < 10; ++k) {
-    lagged.advance(600);
+    kept.advance(600);
     direct.advance(600);
   }
-  const long after_steps = lagged.timings().factorizations;
-  CHECK(after_steps < lagged.timings().nonlinear_iterations / 4);
-  // A new conductivity changes the Jacobian off its diagonal: factorise afresh.
-  const std::vector<double> k(lagged.mesh().num_cells(), 3 * lagged.conductivity()[0]);
-  lagged.set_conductivity(k);
+  // Fixed steps and conductivity: a factor the iterations converge on serves
+  // the whole run.
+  CHECK(kept.timings().factorizations == 1);
+  CHECK(kept.timings().nonlinear_iterations > 10);
+  CHECK(agrees(kept, direct));
+  // A conductivity 1 % higher changes the Jacobian off its diagonal: one new
+  // factor, though iterations on the old one would still converge.
+  const std::vector<double> k(kept.mesh().num_cells(), 1.01 * kept.conductivity()[0]);
+  kept.set_conductivity(k);
   direct.set_conductivity(k);
-  lagged.advance(600);
+  kept.advance(600);
   direct.advance(600);
-  CHECK(lagged.timings().factorizations > after_steps);
-  CHECK((lagged.unknown() - direct.unknown()).lpNorm<Eigen::Infinity>() <
-        1e-9 * direct.unknown().lpNorm<Eigen::Infinity>());
-  // An allowance of one iteration renews the factor whenever it is not exact;
-  // the answer stays the direct solver's.
-  auto eager = solver(1);
-  auto direct_again = rectangle_solver(seepage::Law::gas, {10, 1}, {40, 4}, coal, {fixed_pressure("left", 1e5)});
+  CHECK(kept.timings().factorizations == 2);
+  CHECK(agrees(kept, direct));
+  // A small allowance: factors are renewed once iterations pass half of it
+  // (or, past all of it, solved directly), every renewal counted, and the
+  // answer stays the direct solver's.
+  auto eager = lagged_with(4);
+  auto direct_again = solver({});
   for (int k = 0; k < 10; ++k) {
     eager.advance(600);
     direct_again.advance(600);
   }
-  CHECK(eager.timings().factorizations > 2 * after_steps);
-  CHECK((eager.unknown() - direct_again.unknown()).lpNorm<Eigen::Infinity>() <
-        1e-9 * direct_again.unknown().lpNorm<Eigen::Infinity>());
+  const auto& t = eager.timings();
+  INFO("renewals " << t.lagged_renewals << ", fallbacks " << t.lagged_fallbacks);
+  CHECK(t.lagged_renewals > 0);
+  CHECK(t.factorizations == 1 + t.lagged_renewals + t.lagged_fallbacks);
+  CHECK(agrees(eager, direct_again));
 }
 
 TEST_CASE("conjugate gradients solve the linear law as CHOLMOD does, reusing their preconditioner",

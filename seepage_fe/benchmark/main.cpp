@@ -86,7 +86,6 @@ struct Contender {
   seepage::Timings best{};  // the round with the cheapest Newton iteration
   double best_per_iteration = std::numeric_limits<double>::infinity();
   double difference = 0;  // max |u - u_reference| / max |u_reference| after a round
-  long steps = 0;
 };
 
 seepage::Timings minus(const seepage::Timings& a, const seepage::Timings& b) {
@@ -136,7 +135,6 @@ void newton_rows(const CaseOf<Dim>& c, const std::vector<std::string>& linear_so
       else
         k.difference = std::max(k.difference, (u - reference).lpNorm<Eigen::Infinity>() / reference.lpNorm<Eigen::Infinity>());
       const double per_iteration = d.total_step / static_cast<double>(d.nonlinear_iterations);
-      ++k.steps;
       if (per_iteration < k.best_per_iteration) {
         k.best_per_iteration = per_iteration;
         k.best = d;
