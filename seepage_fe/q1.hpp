@@ -50,23 +50,16 @@ inline Point evaluate(const Corners& x, double xi, double eta) {
   return p;
 }
 
-// A nodal field (indexed by node number) and its gradient at a reference
-// point of the cell with these corners and nodes.
-struct Sample {
+inline Point evaluate(const Corners& x, const Eigen::Vector2d& r) { return evaluate(x, r.x(), r.y()); }
+
+// A nodal field's value and gradient at a point (q1::sample below).
+template <int Dim>
+struct SampleOf {
   double value;
-  Eigen::Vector2d gradient;
+  Eigen::Matrix<double, Dim, 1> gradient;
 };
-template <class Nodal>
-Sample sample(const Corners& x, const std::array<int, 4>& nodes, const Nodal& u, const Eigen::Vector2d& reference) {
-  const Point p = evaluate(x, reference.x(), reference.y());
-  Sample s{0.0, Eigen::Vector2d::Zero()};
-  for (int a = 0; a < 4; ++a) {
-    const double ua = u[nodes[a]];
-    s.value += p.n[a] * ua;
-    s.gradient += p.grad[a] * ua;
-  }
-  return s;
-}
+using Sample = SampleOf<2>;
+using Sample3 = SampleOf<3>;
 
 // The same on a parallelogram, whose inverse Jacobian d(xi, eta) / d(x, y) is
 // constant and known: no Jacobian to build and invert per point (coupled runs
@@ -193,15 +186,14 @@ inline Point3 evaluate(const Corners3& x, const Eigen::Vector3d& r) {
   return p;
 }
 
-struct Sample3 {
-  double value;
-  Eigen::Vector3d gradient;
-};
-template <class Nodal>
-Sample3 sample(const Corners3& x, const std::array<int, 8>& nodes, const Nodal& u, const Eigen::Vector3d& reference) {
-  const Point3 p = evaluate(x, reference);
-  Sample3 s{0.0, Eigen::Vector3d::Zero()};
-  for (int a = 0; a < 8; ++a) {
+// A nodal field (indexed by node number) and its gradient at a reference
+// point of the cell (quadrilateral or hexahedron) with these corners and nodes.
+template <class Cell, std::size_t N, class Nodal, class Reference>
+SampleOf<Reference::RowsAtCompileTime> sample(const Cell& x, const std::array<int, N>& nodes, const Nodal& u,
+                                              const Reference& reference) {
+  const auto p = evaluate(x, reference);
+  SampleOf<Reference::RowsAtCompileTime> s{0.0, Reference::Zero()};
+  for (std::size_t a = 0; a < N; ++a) {
     const double ua = u[nodes[a]];
     s.value += p.n[a] * ua;
     s.gradient += p.grad[a] * ua;
@@ -287,8 +279,6 @@ inline std::optional<Eigen::Vector3d> inverse_map(const Corners3& x, const Eigen
 }
 
 // ---- both dimensions by one name
-
-inline Point evaluate(const Corners& x, const Eigen::Vector2d& r) { return evaluate(x, r.x(), r.y()); }
 
 // The 2^Dim Gauss points of the 2x2(x2) rule.
 template <int Dim>
