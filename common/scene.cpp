@@ -369,6 +369,12 @@ std::string Table::key_path(std::string_view key) const {
 
 bool Table::has(std::string_view key) const { return table_->get(key) != nullptr; }
 
+std::optional<std::size_t> Table::array_length(std::string_view key) const {
+  const toml::node* n = table_->get(key);
+  if (const auto* arr = n ? n->as_array() : nullptr) return arr->size();
+  return std::nullopt;
+}
+
 const toml::node* Table::node(std::string_view key) const {
   const toml::node* n = table_->get(key);
   if (n) doc_->mark_used(n);
@@ -498,24 +504,27 @@ std::vector<double> Table::quantity_vector(const Key& key, const units::Dimensio
   return values;
 }
 
-std::vector<std::array<double, 2>> Table::quantity_points(const Key& key,
-                                                         const units::Dimension& dimension) const {
+std::vector<std::vector<double>> Table::quantity_points(const Key& key, const units::Dimension& dimension,
+                                                       std::size_t components) const {
   const toml::node* n = required_node(key);
-  const std::string form = fmt::format("expected an array of points [[\"x\", \"y\"], ...], each coordinate {} "
-                                       "with its unit",
+  const std::string form = fmt::format("expected an array of points [{}, ...], each coordinate {} with its unit",
+                                       components == 2 ? "[\"x\", \"y\"]" : "[\"x\", \"y\", \"z\"]",
                                        with_article(units::describe(dimension)));
   const auto* arr = n ? n->as_array() : nullptr;
   if (!arr) fail(key.name, form);
-  std::vector<std::array<double, 2>> points;
+  std::vector<std::vector<double>> points;
   for (const auto& item : *arr) {
-    const auto* pair = item.as_array();
-    if (!pair || pair->size() != 2 || !pair->get(0)->is_string() || !pair->get(1)->is_string())
-      fail(key.name, form);
-    const auto fail_here = [&](const std::string& m) { fail(key.name, m); };
-    points.push_back({quantity_from_text(pair->get(0)->as_string()->get(), dimension, fail_here).si,
-                      quantity_from_text(pair->get(1)->as_string()->get(), dimension, fail_here).si});
+    const auto* point = item.as_array();
+    if (!point || point->size() != components) fail(key.name, form);
+    auto& values = points.emplace_back();
+    for (const auto& coordinate : *point) {
+      if (!coordinate.is_string()) fail(key.name, form);
+      values.push_back(
+          quantity_from_text(coordinate.as_string()->get(), dimension, [&](const std::string& m) { fail(key.name, m); })
+              .si);
+    }
   }
-  record(key, node_text(*n), false, "[time, value] pairs: " + units::describe(dimension));
+  record(key, node_text(*n), false, fmt::format("points of {} coordinates: {}", components, units::describe(dimension)));
   return points;
 }
 

@@ -96,6 +96,10 @@ class Table {
 
   const std::string& path() const { return path_; }
   bool has(std::string_view key) const;
+  // The number of entries of an array key; nullopt when absent or no array.
+  // Reads nothing (the key's getter still must): what a reader decides from
+  // before it reads the key, as a scene's dimension from its grid's size.
+  std::optional<std::size_t> array_length(std::string_view key) const;
 
   // Dimensional value written with its unit; returned in SI.
   double quantity(const Key& key, const units::Dimension& dimension) const;
@@ -105,8 +109,9 @@ class Table {
                                                   const units::Dimension& b) const;
   std::vector<double> quantity_vector(const Key& key, const units::Dimension& dimension,
                                       std::size_t count) const;
-  // An array of points, each a pair of quantities: [["0 m", "1 m"], ...].
-  std::vector<std::array<double, 2>> quantity_points(const Key& key, const units::Dimension& dimension) const;
+  // An array of points, each `components` quantities: [["0 m", "1 m"], ...].
+  std::vector<std::vector<double>> quantity_points(const Key& key, const units::Dimension& dimension,
+                                                   std::size_t components) const;
   double number(const Key& key) const;
   // An integer checked against the key's range and the range of T (the type
   // the program stores it in), so no value wraps when it is stored.

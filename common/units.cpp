@@ -81,7 +81,7 @@ const std::array<NamedDimension, 20> named_dimensions{{
     {"gas content coefficient per mass (volume / (mass pressure^1/2))",
      gas_content_per_mass},
     {"force per length", {0, 1, -2, 0}},
-    {"force", {1, 1, -2, 0}},
+    {"force", force},
     {"frequency", {0, 0, -1, 0}},
     {"energy", {2, 1, -2, 0}},
 }};

@@ -37,6 +37,7 @@ inline constexpr Dimension inverse_pressure{1, -1, 2, 0};
 inline constexpr Dimension area{2, 0, 0, 0};
 inline constexpr Dimension viscosity{-1, 1, -1, 0};
 inline constexpr Dimension rate{0, 0, -1, 0};  // 1/s
+inline constexpr Dimension force{1, 1, -2, 0};             // N
 inline constexpr Dimension force_per_length{0, 1, -2, 0};  // N/m: a 2D model's force per metre of depth
 inline constexpr Dimension energy_per_area = force_per_length;  // J/m2 = N/m: a fracture energy
 // lambda in q = -lambda grad(p^2): m^2 / (Pa^2 s)

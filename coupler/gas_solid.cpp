@@ -125,7 +125,7 @@ void SeepageParticipant::restore() { solver_.restore_state(saved_); }
 
 // ---- solid
 
-SolidParticipant::SolidParticipant(mpm::Solver& solver, const MeshMapping& mapping, const GasSolidSettings& settings,
+SolidParticipant::SolidParticipant(mpm::Solver<2>& solver, const MeshMapping& mapping, const GasSolidSettings& settings,
                                    Eigen::VectorXd pressure, std::optional<double> fixed_time_step)
     : solver_(solver),
       mapping_(mapping),

@@ -154,7 +154,7 @@ class SolidParticipant final : public Participant {
   // Of `settings` it uses alpha, the gas force's form, Biot storage
   // ("dilatation" is tracked and sent only with it), the fixed-stress split
   // and the window pressure.
-  SolidParticipant(mpm::Solver& solver, const MeshMapping& mapping, const GasSolidSettings& settings,
+  SolidParticipant(mpm::Solver<2>& solver, const MeshMapping& mapping, const GasSolidSettings& settings,
                    Eigen::VectorXd pressure, std::optional<double> fixed_time_step);
   std::string name() const override { return "solid"; }
   void write(const std::string& field, const Eigen::VectorXd& values) override;
@@ -183,7 +183,7 @@ class SolidParticipant final : public Participant {
   void compute_averages() const;
   void mark_window_start();
 
-  mpm::Solver& solver_;
+  mpm::Solver<2>& solver_;
   const MeshMapping& mapping_;
   double biot_;
   GasForce force_;
@@ -199,7 +199,7 @@ class SolidParticipant final : public Participant {
   bool sends_dilatation_;
   std::vector<double> start_volume_;  // per particle id, at the window's start
   mpm::StepInfo last_window_{0};
-  mpm::Solver::State saved_;
+  mpm::Solver<2>::State saved_;
   Eigen::VectorXd saved_pressure_;
   mutable std::optional<MeshMapping::Averages> averages_;  // of the current state
 };

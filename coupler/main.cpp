@@ -102,7 +102,7 @@ int run(const RunOptions& options, scene::Document& doc) {
                solid.particles().size(), cs.window);
 
   seepage::Output seepage_out(directory, info, seepage_solver, resume_run);
-  mpm::Output solid_out(directory, info, tracers, resume_run);
+  mpm::Output<2> solid_out(directory, info, tracers, resume_run);
   WindowLog log(directory / "coupling.csv", cs.scheme.to_first, resume_run);
   seepage_out.series().list_with_others();
   solid_out.series().list_with_others();
@@ -112,7 +112,7 @@ int run(const RunOptions& options, scene::Document& doc) {
   struct Driver {
     coupling::CoupledModel& model;
     seepage::Output& seepage_out;
-    mpm::Output& solid_out;
+    mpm::Output<2>& solid_out;
     WindowLog& log;
     long iterations = 0;
     double kinetic = 0;  // after the last window [J/m]

@@ -138,7 +138,12 @@ CoupledSetup read_coupled_scene(scene::Table root) {
     root.table("scene", "", true)->fail("solvers", "outburst couples \"seepage\" and \"mpm\"; run seepage-fe or "
                                                    "mpm-solid for one alone");
   s.seepage = seepage::read_setup(*root.table("seepage", "the gas seepage solver", true), false);
-  s.solid = mpm::read_setup(*root.table("mpm", "the material point solver", true));
+  const auto mpm_table = root.table("mpm", "the material point solver", true);
+  // The coupling's mapping, averages and occupancy are plane ones so far.
+  if (mpm::scene_dimension(*mpm_table) != 2)
+    mpm_table->table("grid", "", true)->fail("size", "the coupled solver runs plane-strain scenes (a size of two "
+                                                     "lengths); a 3D MPM scene runs alone in mpm-solid");
+  s.solid = mpm::read_setup<2>(*mpm_table);
   const auto coupling = root.table("coupling", "the gas-solid coupling", true);
   s.coupling = read_coupling(*coupling);
   if (s.coupling.gas_solid.biot_storage && s.seepage.model.law != seepage::Law::linear)
@@ -190,7 +195,7 @@ CoupledModel::CoupledModel(CoupledSetup setup, bool settle_later) : setup_(std::
   // The solver keeps the one copy of the mesh; the mapping reads it through
   // the solver's sampler.
   seepage_ = std::make_unique<seepage::Solver>(std::move(seep.mesh), seep.model, seep.settings);
-  solid_ = std::make_unique<mpm::Solver>(solid.grid, std::move(solid.materials), std::move(solid.particles),
+  solid_ = std::make_unique<mpm::Solver<2>>(solid.grid, std::move(solid.materials), std::move(solid.particles),
                                          solid.settings);
   mapping_ = std::make_unique<MeshMapping>(seepage_->sampler());
   GasSolidSettings gas_solid = cs.gas_solid;

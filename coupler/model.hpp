@@ -22,7 +22,7 @@ namespace outburst::coupling {
 struct CoupledSetup {
   SceneHeader header;
   seepage::Setup seepage;
-  mpm::Setup solid;
+  mpm::Setup<2> solid;
   CouplingSetup coupling;
 };
 
@@ -46,7 +46,7 @@ class CoupledModel {
   // settle() runs it, or load() of a checkpoint of the run makes it needless.
   explicit CoupledModel(CoupledSetup setup, bool settle_later = false);
   // Runs the settling stage, or carries on with it after load() of a
-  // checkpoint taken during it; `pause` as for mpm::Solver::settle. False
+  // checkpoint taken during it; `pause` as for mpm::Solver<2>::settle. False
   // when paused.
   bool settle(const std::function<bool()>& pause);
 
@@ -57,7 +57,7 @@ class CoupledModel {
   // live in the solvers now).
   const CouplingSetup& coupling_setup() const { return setup_.coupling; }
   seepage::Solver& seepage() { return *seepage_; }
-  mpm::Solver& solid() { return *solid_; }
+  mpm::Solver<2>& solid() { return *solid_; }
   const MeshMapping& mapping() const { return *mapping_; }
   const SeepageParticipant& seepage_side() const { return *seepage_side_; }
   const SolidParticipant& solid_side() const { return *solid_side_; }
@@ -73,7 +73,7 @@ class CoupledModel {
  private:
   CoupledSetup setup_;
   std::unique_ptr<seepage::Solver> seepage_;
-  std::unique_ptr<mpm::Solver> solid_;
+  std::unique_ptr<mpm::Solver<2>> solid_;
   std::unique_ptr<MeshMapping> mapping_;
   std::unique_ptr<SeepageParticipant> seepage_side_;
   std::unique_ptr<SolidParticipant> solid_side_;

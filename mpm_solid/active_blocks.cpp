@@ -4,23 +4,35 @@
 
 namespace outburst::mpm {
 
-ActiveBlocks::ActiveBlocks(const Grid<2>& grid, const std::array<bool, 4>& mirrored, int threads) {
-  for (int d = 0; d < 2; ++d) {
+template <int Dim>
+ActiveBlocks<Dim>::ActiveBlocks(const Grid<Dim>& grid, const std::array<bool, 2 * Dim>& mirrored, int threads) {
+  std::size_t count = 1;
+  for (int d = 0; d < Dim; ++d) {
     nodes_[d] = grid.nodes_along(d);
     blocks_[d] = (nodes_[d] + size - 1) / size;
+    count *= static_cast<std::size_t>(blocks_[d]);
   }
-  const std::size_t count = static_cast<std::size_t>(blocks_[0]) * static_cast<std::size_t>(blocks_[1]);
+  strides_[0] = blocks_[0];
+  if constexpr (Dim == 3) strides_[1] = blocks_[0] * blocks_[1];
   marks_.assign(static_cast<std::size_t>(threads), std::vector<std::uint8_t>(count, 0));
   active_.assign(count, 0);
-  const int g = Grid<2>::ghost;
-  for (int side = 0; side < 4; ++side) {
+  const int g = Grid<Dim>::ghost;
+  for (int side = 0; side < 2 * Dim; ++side) {
     if (!mirrored[side]) continue;
     const int axis = side / 2, wall_row = side % 2 == 0 ? g : g + grid.cells[axis];
     strips_.push_back({axis, std::max(0, wall_row - g), std::min(nodes_[axis] - 1, wall_row + g)});
   }
 }
 
-void ActiveBlocks::collect() {
+template <int Dim>
+std::size_t ActiveBlocks<Dim>::block_index(const std::array<int, Dim>& b) const {
+  std::size_t flat = 0;
+  for (int d = Dim - 1; d >= 0; --d) flat = flat * static_cast<std::size_t>(blocks_[d]) + static_cast<std::size_t>(b[d]);
+  return flat;
+}
+
+template <int Dim>
+void ActiveBlocks<Dim>::collect() {
   std::fill(active_.begin(), active_.end(), 0);
   for (auto& m : marks_)
     for (std::size_t b = 0; b < m.size(); ++b) {
@@ -31,42 +43,58 @@ void ActiveBlocks::collect() {
   // mass onto it: where a block of the strip along the wall is active, so is
   // the rest of the strip across it.
   for (const Strip& s : strips_) {
-    const int across = 1 - s.axis;
-    for (int k = 0; k < blocks_[across]; ++k) {
-      std::array<int, 2> b{};
-      b[across] = k;
+    std::array<int, Dim> b{};
+    // Over the blocks of the strip's first layer; each stands for its column
+    // across the strip.
+    for (std::size_t flat = 0; flat < active_.size(); ++flat) {
+      std::size_t rest = flat;
+      for (int d = 0; d < Dim; ++d) {
+        b[d] = static_cast<int>(rest % static_cast<std::size_t>(blocks_[d]));
+        rest /= static_cast<std::size_t>(blocks_[d]);
+      }
+      if (b[s.axis] != s.from / size) continue;
       bool any = false;
-      for (b[s.axis] = s.from / size; b[s.axis] <= s.to / size; ++b[s.axis])
-        any = any || active_[static_cast<std::size_t>(b[1] * blocks_[0] + b[0])];
+      for (b[s.axis] = s.from / size; b[s.axis] <= s.to / size; ++b[s.axis]) any = any || active_[block_index(b)];
       if (!any) continue;
-      for (b[s.axis] = s.from / size; b[s.axis] <= s.to / size; ++b[s.axis])
-        active_[static_cast<std::size_t>(b[1] * blocks_[0] + b[0])] = 1;
+      for (b[s.axis] = s.from / size; b[s.axis] <= s.to / size; ++b[s.axis]) active_[block_index(b)] = 1;
     }
   }
   runs_.clear();
   active_nodes_ = 0;
-  for (int j = 0; j < nodes_[1]; ++j) {
-    const std::size_t row = static_cast<std::size_t>(j) * static_cast<std::size_t>(nodes_[0]);
-    for (int bx = 0; bx < blocks_[0]; ++bx) {
-      if (!active_[static_cast<std::size_t>((j / size) * blocks_[0] + bx)]) continue;
-      const int from = bx * size, count = std::min(nodes_[0], from + size) - from;
-      // Runs stay within a row: merged across rows, a body as wide as the
-      // grid would make one run of every node, and the passes, parallel
-      // over runs, one thread's work.
-      if (from > 0 && !runs_.empty() &&
-          runs_.back().first + static_cast<std::size_t>(runs_.back().count) == row + from)
-        runs_.back().count += count;
-      else
-        runs_.push_back({row + static_cast<std::size_t>(from), count});
-      active_nodes_ += static_cast<std::size_t>(count);
+  // Rows of nodes along x: j in 2D, (j, k) in 3D.
+  const int layers = Dim == 2 ? 1 : nodes_[Dim - 1];
+  for (int k = 0; k < layers; ++k)
+    for (int j = 0; j < nodes_[1]; ++j) {
+      const std::size_t row =
+          (static_cast<std::size_t>(k) * static_cast<std::size_t>(nodes_[1]) + static_cast<std::size_t>(j)) *
+          static_cast<std::size_t>(nodes_[0]);
+      std::array<int, Dim> b{};
+      b[1] = j / size;
+      if constexpr (Dim == 3) b[2] = k / size;
+      for (b[0] = 0; b[0] < blocks_[0]; ++b[0]) {
+        if (!active_[block_index(b)]) continue;
+        const int from = b[0] * size, count = std::min(nodes_[0], from + size) - from;
+        // Runs stay within a row: merged across rows, a body as wide as the
+        // grid would make one run of every node, and the passes, parallel
+        // over runs, one thread's work.
+        if (from > 0 && !runs_.empty() &&
+            runs_.back().first + static_cast<std::size_t>(runs_.back().count) == row + from)
+          runs_.back().count += count;
+        else
+          runs_.push_back({row + static_cast<std::size_t>(from), count});
+        active_nodes_ += static_cast<std::size_t>(count);
+      }
     }
-  }
 }
 
-std::size_t ActiveBlocks::bytes() const {
+template <int Dim>
+std::size_t ActiveBlocks<Dim>::bytes() const {
   std::size_t b = active_.capacity() + runs_.capacity() * sizeof(Run);
   for (const auto& m : marks_) b += m.capacity();
   return b;
 }
+
+template class ActiveBlocks<2>;
+template class ActiveBlocks<3>;
 
 }  // namespace outburst::mpm

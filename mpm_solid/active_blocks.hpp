@@ -1,10 +1,11 @@
 #pragma once
-// The part of the grid a step can touch: the blocks of B x B nodes that some
-// particle's stencil reaches, and beside a fixed or roller wall the blocks its
-// ghost nodes mirror into. Every nodal array is zero outside them, so the
-// grid's own passes (clearing, summing the threads' copies, velocities, the
-// update, the energy books) run over these nodes only, and a mostly empty grid
-// (a long tunnel, rock around a seam) costs in proportion to its particles.
+// The part of the grid a step can touch: the blocks of nodes (8 x 8 in 2D,
+// 4 x 4 x 4 in 3D) that some particle's stencil reaches, and beside a fixed or
+// roller wall the blocks its ghost nodes mirror into. Every nodal array is
+// zero outside them, so the grid's own passes (clearing, summing the threads'
+// copies, velocities, the update, the energy books) run over these nodes only,
+// and a mostly empty grid (a long tunnel, rock around a seam) costs in
+// proportion to its particles.
 
 #include <array>
 #include <cstdint>
@@ -14,24 +15,46 @@
 
 namespace outburst::mpm {
 
+// A contiguous run of nodes, the unit the grid's passes share out.
+struct NodeRun {
+  std::size_t first;
+  int count;
+};
+
+template <int Dim>
 class ActiveBlocks {
  public:
-  static constexpr int size = 8;  // nodes per block side
+  // Nodes per block side: 64 nodes a block in either dimension. A stencil
+  // (at most 3 nodes a side) spans at most two blocks along each axis.
+  static constexpr int size = Dim == 2 ? 8 : 4;
 
-  // mirrored[side]: whether the wall on that side (left, right, bottom, top)
-  // mirrors its ghost nodes (fixed and roller walls do).
-  ActiveBlocks(const Grid<2>& grid, const std::array<bool, 4>& mirrored, int threads);
+  // mirrored[side]: whether the wall on that side (left, right, bottom, top,
+  // and in 3D back, front) mirrors its ghost nodes (fixed and roller walls do).
+  ActiveBlocks(const Grid<Dim>& grid, const std::array<bool, 2 * Dim>& mirrored, int threads);
 
   // Thread t's marks: a stencil whose lowest node is `base`, `support` nodes
   // per side, marks the blocks it reaches (set_reached, inlined in the loops).
   std::uint8_t* marks(int t) { return marks_[static_cast<std::size_t>(t)].data(); }
-  int blocks_along_x() const { return blocks_[0]; }
+  // Blocks along x (and, in 3D, along x times along y): the strides of the
+  // marks' index.
+  const std::array<int, Dim - 1>& strides() const { return strides_; }
   template <int Support>
-  static void set_reached(std::uint8_t* marks, int blocks_along_x, const std::array<int, 2>& base) {
+  static void set_reached(std::uint8_t* marks, const std::array<int, Dim - 1>& strides,
+                          const std::array<int, Dim>& base) {
     const int x0 = base[0] / size, x1 = (base[0] + Support - 1) / size;
     const int y0 = base[1] / size, y1 = (base[1] + Support - 1) / size;
-    marks[y0 * blocks_along_x + x0] = marks[y0 * blocks_along_x + x1] = 1;
-    marks[y1 * blocks_along_x + x0] = marks[y1 * blocks_along_x + x1] = 1;
+    if constexpr (Dim == 2) {
+      const int row = strides[0];
+      marks[y0 * row + x0] = marks[y0 * row + x1] = 1;
+      marks[y1 * row + x0] = marks[y1 * row + x1] = 1;
+    } else {
+      const int z0 = base[2] / size, z1 = (base[2] + Support - 1) / size;
+      for (const int z : {z0, z1})
+        for (const int y : {y0, y1}) {
+          const int first = z * strides[1] + y * strides[0];
+          marks[first + x0] = marks[first + x1] = 1;
+        }
+    }
   }
 
   // The threads' marks (cleared) become the active blocks, with the walls'
@@ -39,16 +62,16 @@ class ActiveBlocks {
   void collect();
 
   // Contiguous runs of active nodes, in increasing node order.
-  struct Run {
-    std::size_t first;
-    int count;
-  };
+  using Run = NodeRun;
   const std::vector<Run>& runs() const { return runs_; }
   std::size_t active_nodes() const { return active_nodes_; }
   std::size_t bytes() const;
 
  private:
-  std::array<int, 2> nodes_, blocks_;
+  std::size_t block_index(const std::array<int, Dim>& b) const;
+
+  std::array<int, Dim> nodes_, blocks_;
+  std::array<int, Dim - 1> strides_;
   // For each mirroring wall: its axis and the node rows (along that axis) its
   // ghosts and their mirrors take, [from, to].
   struct Strip {

@@ -2,6 +2,7 @@
 #include <chrono>
 #include <optional>
 
+#include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
 #include "common/output_folder.hpp"
@@ -16,23 +17,22 @@ using namespace outburst;
 
 namespace {
 
-int run(const RunOptions& options, scene::Document& doc) {
-  auto root = doc.root();
-  const SceneHeader header = read_scene_header(root);
-  require_solvers(root, header, {"mpm"}, "mpm-solid");
-  const auto mpm_table = root.table("mpm", "the material point solver", true);
-  mpm::Setup setup = mpm::read_setup(*mpm_table);
+// The run of a scene of dimension Dim (2: plane strain, 3: 3D).
+template <int Dim>
+int run_in(const RunOptions& options, scene::Document& doc, const SceneHeader& header, const scene::Table& mpm_table) {
+  mpm::Setup<Dim> setup = mpm::read_setup<Dim>(mpm_table);
   doc.reject_unused();
-  mpm::check_run_length(*mpm_table, setup, header.end_time);
+  mpm::check_run_length(mpm_table, setup, header.end_time);
 
-  mpm::check_time_step(*mpm_table, setup);
-  mpm::Solver solver(setup.grid, std::move(setup.materials), std::move(setup.particles), setup.settings);
+  mpm::check_time_step(mpm_table, setup);
+  mpm::Solver<Dim> solver(setup.grid, std::move(setup.materials), std::move(setup.particles), setup.settings);
   const double stable = solver.stable_time_step();
   if (!finish_reading(options, doc)) return 0;
   const OutputFolder folder(options.output_directory(), "mpm-solid", options.earlier_files());
-  spdlog::info("{}: {} particles, {} x {} cells of {:g} m, stable step {:.3g} s", header.title,
-               solver.particles().size(), setup.grid.cells[0], setup.grid.cells[1], setup.grid.h, stable);
-  const auto info = run_info("mpm-solid", doc, "SI: m, s, kg, Pa; 2D plane strain, per metre of depth");
+  spdlog::info("{}: {} particles, {} cells of {:g} m, stable step {:.3g} s", header.title,
+               solver.particles().size(), fmt::join(setup.grid.cells, " x "), setup.grid.h, stable);
+  const auto info =
+      run_info("mpm-solid", doc, Dim == 2 ? "SI: m, s, kg, Pa; 2D plane strain, per metre of depth" : "SI: m, s, kg, Pa; 3D");
   std::optional<checkpoint::Reader> restart;
   if (options.restart) restart.emplace(folder.path(), info);
   // A checkpoint of the settling stage continues it; the run then starts as
@@ -54,11 +54,11 @@ int run(const RunOptions& options, scene::Document& doc) {
     spdlog::info("settled for {:.3g} s: kinetic energy down to {:.2e} of its peak; supports removed",
                  setup.settling.duration, *left);
   }
-  mpm::Output out(folder.path(), info, setup.tracers, resume_run);
+  mpm::Output<Dim> out(folder.path(), info, setup.tracers, resume_run);
   // Explicit steps of the stable size (or the scene's fixed one).
   struct Driver {
-    mpm::Solver& solver;
-    mpm::Output& out;
+    mpm::Solver<Dim>& solver;
+    mpm::Output<Dim>& out;
     std::optional<double> fixed_step;
     double last_snapshot_time = 0;
 
@@ -103,8 +103,9 @@ int run(const RunOptions& options, scene::Document& doc) {
   if (end == RunEnd::stopped) return report_stop(solver.time(), out.series().index_path());
   out.finish();
   if (end == RunEnd::at_rest)
-    spdlog::info("at rest at t = {:.4g} s: kinetic energy {:.3g} J/m, below {:g} of its peak {:.3g} J/m",
-                 solver.time(), solver.kinetic_energy(), *header.rest_fraction, loop.peak_kinetic_energy());
+    spdlog::info("at rest at t = {0:.4g} s: kinetic energy {1:.3g} {2}, below {3:g} of its peak {4:.3g} {2}",
+                 solver.time(), solver.kinetic_energy(), Dim == 2 ? "J/m" : "J", *header.rest_fraction,
+                 loop.peak_kinetic_energy());
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   spdlog::info("done: {} steps, {:.3g} s wall, {:.3g} particle-steps/s, {} particles left the grid",
                solver.steps(), wall, static_cast<double>(solver.steps()) * static_cast<double>(solver.particles().size()) / wall,
@@ -113,9 +114,18 @@ int run(const RunOptions& options, scene::Document& doc) {
   return 0;
 }
 
+int run(const RunOptions& options, scene::Document& doc) {
+  auto root = doc.root();
+  const SceneHeader header = read_scene_header(root);
+  require_solvers(root, header, {"mpm"}, "mpm-solid");
+  const auto mpm_table = root.table("mpm", "the material point solver", true);
+  return mpm::scene_dimension(*mpm_table) == 2 ? run_in<2>(options, doc, header, *mpm_table)
+                                               : run_in<3>(options, doc, header, *mpm_table);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  return run_program("mpm-solid", "Coal and rock: explicit material point method (2D plane strain)", argc, argv,
-                     run);
+  return run_program("mpm-solid", "Coal and rock: explicit material point method (2D plane strain or 3D)", argc,
+                     argv, run);
 }

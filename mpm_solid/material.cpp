@@ -11,15 +11,21 @@ double Elasticity::p_wave_speed() const {
   return std::sqrt((lame_lambda() + 2 * shear_modulus()) / density);
 }
 
-Dissipation Material::update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const {
+template <int Dim>
+Dissipation Material<Dim>::update_stress(Particles<Dim>& p, const std::vector<int>& members, double dt) const {
   return over_chunks(members, [&](std::span<const int> part) { return update_chunk(p, part, dt); });
 }
 
-double Material::strain_energy(const Particles<2>& p, const std::vector<int>& members) const {
+template <int Dim>
+double Material<Dim>::strain_energy(const Particles<Dim>& p, const std::vector<int>& members) const {
   return sum_over(members, [&](int i) {
-    return 0.5 * p.volume[i] * compliance_product(p.stress[i], p.stress_zz[i], p.stress[i], p.stress_zz[i]);
+    const double zz = Dim == 2 ? p.stress_zz[i] : 0.0;
+    return 0.5 * p.volume[i] * compliance_product(p.stress[i], zz, p.stress[i], zz);
   });
 }
+
+template class Material<2>;
+template class Material<3>;
 
 std::pair<double, double> DruckerPragerFit::coefficients(Kind kind, double c, double phi) {
   const double s = std::sin(phi), co = std::cos(phi), sqrt3 = std::sqrt(3.0);

@@ -35,7 +35,7 @@ struct Elasticity {
   double p_wave_speed() const;
 };
 
-// Energy a stress update turns into heat and cracks [J per m of depth].
+// Energy a stress update turns into heat and cracks [J; per m of depth in 2D].
 struct Dissipation {
   double plastic = 0;  // plastic work
   double damage = 0;   // strain energy released as damage grows, Y dD
@@ -46,6 +46,12 @@ struct Dissipation {
   }
 };
 
+// Everything below is written once for plane strain (Dim = 2) and 3D: the
+// plane forms are the 3D ones with d_zz = 0. A plane-strain stress is the
+// in-plane matrix and the out-of-plane normal stress s_zz beside it; a 3D
+// stress matrix holds all of it, and the functions below that take an s_zz
+// touch it only in 2D (out_of_plane gives 3D updates a value to pass).
+template <int Dim>
 class Material {
  public:
   virtual ~Material() = default;
@@ -64,7 +70,7 @@ class Material {
   // Creates the optional particle fields the model keeps (plastic strain,
   // damage) and sets those of its own particles, `members`; the solver calls
   // it before the first step.
-  virtual void create_fields(Particles<2>&, const std::vector<int>& /*members*/) const {}
+  virtual void create_fields(Particles<Dim>&, const std::vector<int>& /*members*/) const {}
 
   // Update the stresses of particles `members` over a step dt from their
   // velocity gradients (objective: Jaumann rate, paper eqs. 31-33), and carry
@@ -72,22 +78,22 @@ class Material {
   // dissipated in the step. All of a material's particles at once, in
   // parallel: by default update_chunk over chunks of them; a law whose
   // update reads other particles (a nonlocal average) overrides this.
-  virtual Dissipation update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const;
+  virtual Dissipation update_stress(Particles<Dim>& p, const std::vector<int>& members, double dt) const;
 
   // The same for a few particles, serially, for a pointwise() material: the
   // solver calls it from inside its own parallel pass, between gathering the
   // chunk's velocity gradients and scattering its forces, while the chunk's
   // fields are still in cache.
-  virtual Dissipation update_chunk(Particles<2>& p, std::span<const int> members, double dt) const = 0;
+  virtual Dissipation update_chunk(Particles<Dim>& p, std::span<const int> members, double dt) const = 0;
   // Whether a particle's update reads only its own fields.
   virtual bool pointwise() const { return true; }
 
-  // Strain energy stored in particles `members` [J per m of depth].
-  virtual double strain_energy(const Particles<2>& p, const std::vector<int>& members) const;
+  // Strain energy stored in particles `members` [J; per m of depth in 2D].
+  virtual double strain_energy(const Particles<Dim>& p, const std::vector<int>& members) const;
 
-  // a : C0^-1 : b for two plane-strain stress states (C0 the undamaged
-  // stiffness); half of it with a = b is the elastic strain energy density.
-  double compliance_product(const Mat<2>& a, double a_zz, const Mat<2>& b, double b_zz) const;
+  // a : C0^-1 : b for two stress states (C0 the undamaged stiffness); half
+  // of it with a = b is the elastic strain energy density.
+  double compliance_product(const Mat<Dim>& a, double a_zz, const Mat<Dim>& b, double b_zz) const;
 
  private:
   std::string name_;
@@ -110,7 +116,15 @@ struct MaterialContext {
 struct MaterialModel {
   std::string_view name;
   std::string_view description;  // a few words for the key's help
-  std::unique_ptr<Material> (*read)(const scene::Table& table, const MaterialContext& context);
+  std::unique_ptr<Material<2>> (*read_plane)(const scene::Table& table, const MaterialContext& context);
+  std::unique_ptr<Material<3>> (*read_solid)(const scene::Table& table, const MaterialContext& context);
+  template <int Dim>
+  std::unique_ptr<Material<Dim>> read(const scene::Table& table, const MaterialContext& context) const {
+    if constexpr (Dim == 2)
+      return read_plane(table, context);
+    else
+      return read_solid(table, context);
+  }
 };
 
 // The models registered, in a fixed order (by name). The list is taken at the
@@ -121,38 +135,60 @@ const std::vector<MaterialModel>& material_models();
 // Two models of one name are a programming error (std::logic_error).
 bool register_material(const MaterialModel& model);
 
+// Particle i's out-of-plane stress under plane strain (zz its field); a 3D
+// update passes `none`, which the functions below leave alone.
+template <int Dim>
+[[gnu::always_inline]] inline double& out_of_plane(std::vector<double>& zz, int i, double& none) {
+  if constexpr (Dim == 2)
+    return zz[static_cast<std::size_t>(i)];
+  else
+    return none;
+}
+
 // The elastic trial step shared by the elastic-plastic models: Jaumann-rate
 // linear elasticity with Lame constants lambda and G over dt, in place.
 // Inline, with the other kernels below, so that each model's update compiles
 // them into its own loop.
-inline void elastic_trial(double lambda, double shear, const Mat<2>& l, double dt, Mat<2>& s, double& s_zz) {
-  const Mat<2> d = 0.5 * (l + l.transpose());  // rate of deformation
-  const Mat<2> w = 0.5 * (l - l.transpose());  // spin
-  const double trace = d.trace();               // plane strain: d_zz = 0
+template <int Dim>
+inline void elastic_trial(double lambda, double shear, const Mat<Dim>& l, double dt, Mat<Dim>& s, double& s_zz) {
+  const Mat<Dim> d = 0.5 * (l + l.transpose());  // rate of deformation
+  const Mat<Dim> w = 0.5 * (l - l.transpose());  // spin
+  const double trace = d.trace();                 // plane strain: d_zz = 0
   // sigma' = sigma + dt (C : D + W sigma - sigma W)
-  const Mat<2> rotation = w * s - s * w;
-  s += dt * (lambda * trace * Mat<2>::Identity() + 2 * shear * d + rotation);
-  s_zz += dt * lambda * trace;
+  const Mat<Dim> rotation = w * s - s * w;
+  s += dt * (lambda * trace * Mat<Dim>::Identity() + 2 * shear * d + rotation);
+  if constexpr (Dim == 2) s_zz += dt * lambda * trace;
 }
 
-// Mean stress and deviator of a plane-strain state (zz included in both).
+// Mean stress and deviator (plane strain: zz included in both).
+template <int Dim>
 struct Invariants {
-  double mean;        // I1 / 3
-  Mat<2> deviator;    // in-plane part of s
-  double deviator_zz;
+  double mean;          // I1 / 3
+  Mat<Dim> deviator;    // of the matrix part of the stress
+  double deviator_zz;   // plane strain's; 0 in 3D
   double sqrt_j2;
 };
-inline Invariants invariants(const Mat<2>& s, double s_zz) {
-  Invariants r;
-  r.mean = (s.trace() + s_zz) / 3;
-  r.deviator = s - r.mean * Mat<2>::Identity();
-  r.deviator_zz = s_zz - r.mean;
-  r.sqrt_j2 = std::sqrt(0.5 * (r.deviator.squaredNorm() + r.deviator_zz * r.deviator_zz));
+template <int Dim>
+inline Invariants<Dim> invariants(const Mat<Dim>& s, double s_zz) {
+  Invariants<Dim> r;
+  if constexpr (Dim == 2) {
+    r.mean = (s.trace() + s_zz) / 3;
+    r.deviator = s - r.mean * Mat<Dim>::Identity();
+    r.deviator_zz = s_zz - r.mean;
+    r.sqrt_j2 = std::sqrt(0.5 * (r.deviator.squaredNorm() + r.deviator_zz * r.deviator_zz));
+  } else {
+    r.mean = s.trace() / 3;
+    r.deviator = s - r.mean * Mat<Dim>::Identity();
+    r.deviator_zz = 0;
+    r.sqrt_j2 = std::sqrt(0.5 * r.deviator.squaredNorm());
+  }
   return r;
 }
 
-inline double Material::compliance_product(const Mat<2>& a, double a_zz, const Mat<2>& b, double b_zz) const {
-  const auto ia = invariants(a, a_zz), ib = invariants(b, b_zz);
+template <int Dim>
+inline double Material<Dim>::compliance_product(const Mat<Dim>& a, double a_zz, const Mat<Dim>& b,
+                                                double b_zz) const {
+  const auto ia = invariants<Dim>(a, a_zz), ib = invariants<Dim>(b, b_zz);
   const double g = shear_, bulk = lambda_ + 2.0 / 3.0 * g;
   const double deviatoric = ia.deviator.cwiseProduct(ib.deviator).sum() + ia.deviator_zz * ib.deviator_zz;
   return deviatoric / (2 * g) + ia.mean * ib.mean / bulk;
@@ -169,9 +205,10 @@ struct DruckerPragerFit {
 // Return a trial stress to the cone f = alpha I1/3 + sqrt(J2) - k (or its apex)
 // with the potential's alpha_dilation; G and K the elastic moduli. Returns the
 // plastic multiplier and, if asked, the plastic work density [J/m^3].
-inline double drucker_prager_return(double alpha, double k, double alpha_dilation, double g, double bulk, Mat<2>& s,
-                             double& s_zz, double* work_density) {
-  const auto inv = invariants(s, s_zz);
+template <int Dim>
+inline double drucker_prager_return(double alpha, double k, double alpha_dilation, double g, double bulk,
+                                    Mat<Dim>& s, double& s_zz, double* work_density) {
+  const auto inv = invariants<Dim>(s, s_zz);
   const double f = alpha * inv.mean + inv.sqrt_j2 - k;
   if (f <= 0) return 0;
   // Flow along dg/dsigma = (alpha_d / 3) I + s / (2 sqrt(J2)): the mean stress
@@ -187,8 +224,8 @@ inline double drucker_prager_return(double alpha, double k, double alpha_dilatio
     dlambda = inv.sqrt_j2 / g;
   }
   const double scale = inv.sqrt_j2 > 0 ? sqrt_j2 / inv.sqrt_j2 : 0.0;
-  s = mean * Mat<2>::Identity() + scale * inv.deviator;
-  s_zz = mean + scale * inv.deviator_zz;
+  s = mean * Mat<Dim>::Identity() + scale * inv.deviator;
+  if constexpr (Dim == 2) s_zz = mean + scale * inv.deviator_zz;
   // Plastic work sigma : C^-1 : (sigma_trial - sigma): the deviator only shrinks
   // along itself, so its part is sqrt(J2) (sqrt(J2)_trial - sqrt(J2)) / G.
   if (work_density) *work_density = sqrt_j2 * (inv.sqrt_j2 - sqrt_j2) / g + mean * (inv.mean - mean) / bulk;
@@ -204,13 +241,13 @@ inline constexpr int chunk_size = 64;
 // dissipated, over `members` in turn, after carrying the particle's
 // deformation gradient and volume over the step: one pass over the particles
 // serves kinematics and constitution.
-template <class Update>
-Dissipation each_member(Particles<2>& p, std::span<const int> members, double dt, Update&& update) {
+template <int Dim, class Update>
+Dissipation each_member(Particles<Dim>& p, std::span<const int> members, double dt, Update&& update) {
   Dissipation total;
   for (const int i : members) {
     // Into a local first: the product evaluated straight into the particle's
     // field goes through a temporary and back through memory.
-    const Mat<2> f = (Mat<2>::Identity() + dt * p.velocity_gradient[i]) * p.deformation[i];
+    const Mat<Dim> f = (Mat<Dim>::Identity() + dt * p.velocity_gradient[i]) * p.deformation[i];
     p.deformation[i] = f;
     p.volume[i] = p.volume0[i] * f.determinant();
     total += update(i);

@@ -16,9 +16,10 @@ namespace outburst::mpm {
 // The averages of value[k], the value of particle members[k] of weight
 // weight[k], over the members within `radius` of it [m] (itself included; its
 // own value where every weight within R is zero); x is indexed by particle.
-// O(n log n + n neighbours): the members are binned into squares of side R by
-// a sort, so a particle far from the rest costs no empty bins.
-std::vector<double> nonlocal_average(const std::vector<Vec<2>>& x, const std::vector<int>& members,
+// O(n log n + n neighbours): the members are binned into squares (cubes in
+// 3D) of side R by a sort, so a particle far from the rest costs no empty bins.
+template <int Dim>
+std::vector<double> nonlocal_average(const std::vector<Vec<Dim>>& x, const std::vector<int>& members,
                                      const std::vector<double>& weight, const std::vector<double>& value,
                                      double radius);
 

@@ -4,7 +4,9 @@
 #include <cmath>
 #include <type_traits>
 
+#include <Eigen/Eigenvalues>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
 namespace outburst::mpm {
@@ -16,31 +18,54 @@ namespace {
 constexpr double integration_warning = 0.1;
 }  // namespace
 
-std::pair<double, double> principal_extremes(const Mat<2>& s, double s_zz) {
-  const double centre = 0.5 * (s(0, 0) + s(1, 1));
-  const double radius = std::hypot(0.5 * (s(0, 0) - s(1, 1)), s(0, 1));
-  return {std::max(centre + radius, s_zz), std::min(centre - radius, s_zz)};
+template <int Dim>
+std::pair<double, double> principal_extremes(const Mat<Dim>& s, double s_zz) {
+  if constexpr (Dim == 2) {
+    const double centre = 0.5 * (s(0, 0) + s(1, 1));
+    const double radius = std::hypot(0.5 * (s(0, 0) - s(1, 1)), s(0, 1));
+    return {std::max(centre + radius, s_zz), std::min(centre - radius, s_zz)};
+  } else {
+    const Vec<3> values = Eigen::SelfAdjointEigenSolver<Mat<3>>(s, Eigen::EigenvaluesOnly).eigenvalues();
+    return {values[2], values[0]};
+  }
 }
 
-Output::Output(const std::filesystem::path& directory, const output::RunInfo& info, std::vector<int> tracers,
-               bool resume)
+template std::pair<double, double> principal_extremes<2>(const Mat<2>&, double);
+template std::pair<double, double> principal_extremes<3>(const Mat<3>&, double);
+
+namespace {
+// "x_m,y_m" or "x_m,y_m,z_m": a column per axis, the name's {} the axis.
+template <int Dim>
+std::string per_axis(std::string_view name) {
+  std::string columns;
+  for (int d = 0; d < Dim; ++d)
+    columns += fmt::format(fmt::runtime(std::string(d == 0 ? "" : ",") + std::string(name)), "xyz"[d]);
+  return columns;
+}
+}  // namespace
+
+template <int Dim>
+Output<Dim>::Output(const std::filesystem::path& directory, const output::RunInfo& info, std::vector<int> tracers,
+                    bool resume)
     : directory_(directory), series_(directory, "particles", info), tracers_(std::move(tracers)) {
   series_.add_point_grid("particles");
   if (resume) return;
   if (!tracers_.empty()) {
     tracer_file_.open(tracer_path(), std::ios::trunc);
-    tracer_file_ << "time_s,tracer,particle_id,x_m,y_m,vx_m_per_s,vy_m_per_s,speed_m_per_s,ux_m,uy_m,"
-                    "sigma_max_Pa,sigma_min_Pa,plastic_strain,damage\n";
+    tracer_file_ << "time_s,tracer,particle_id," << per_axis<Dim>("{}_m") << "," << per_axis<Dim>("v{}_m_per_s")
+                 << ",speed_m_per_s," << per_axis<Dim>("u{}_m") << ",sigma_max_Pa,sigma_min_Pa,plastic_strain,damage\n";
   }
   history_.open(history_path(), std::ios::trunc);
-  history_ << "step,time_s,dt_s,particles,removed_total,kinetic_J_per_m,strain_J_per_m,gravity_J_per_m,"
-              "plastic_J_per_m,damage_J_per_m,damping_J_per_m,walls_J_per_m,transfer_J_per_m,integration_J_per_m,"
-              "left_grid_J_per_m,"
-              "external_work_J_per_m,balance_error_J_per_m\n";
+  const std::string unit = Dim == 2 ? "J_per_m" : "J";
+  history_ << fmt::format("step,time_s,dt_s,particles,removed_total,kinetic_{0},strain_{0},gravity_{0},plastic_{0},"
+                          "damage_{0},damping_{0},walls_{0},transfer_{0},integration_{0},left_grid_{0},"
+                          "external_work_{0},balance_error_{0}\n",
+                          unit);
   history_.flush();
 }
 
-void Output::save(checkpoint::Out out) const {
+template <int Dim>
+void Output<Dim>::save(checkpoint::Out out) const {
   series_.save(out.group("series"));
   checkpoint::save_length(out, "history_bytes", history_path());
   if (!tracers_.empty()) checkpoint::save_length(out, "tracer_bytes", tracer_path());
@@ -49,7 +74,8 @@ void Output::save(checkpoint::Out out) const {
   audit_.save(out.group("audit"));
 }
 
-void Output::load(const checkpoint::In& in) {
+template <int Dim>
+void Output<Dim>::load(const checkpoint::In& in) {
   series_.load(in.group("series"));
   checkpoint::cut_back(in, "history_bytes", history_path(), history_);
   if (!tracers_.empty()) checkpoint::cut_back(in, "tracer_bytes", tracer_path(), tracer_file_);
@@ -58,7 +84,8 @@ void Output::load(const checkpoint::In& in) {
   audit_.load(in.group("audit"));
 }
 
-void Output::snapshot(const Solver& solver) {
+template <int Dim>
+void Output<Dim>::snapshot(const Solver<Dim>& solver) {
   if (!initial_total_) {
     const Energies e = solver.energies();
     initial_total_ = e.total();
@@ -68,14 +95,22 @@ void Output::snapshot(const Solver& solver) {
   const std::size_t n = p.size();
   std::vector<double> xyz, velocity, displacement, stress, s_max, s_min;
   xyz.reserve(3 * n);
+  // ParaView's vectors have three components, and its symmetric tensors six
+  // (xx, xy, xz, yy, yz, zz); a plane state's missing ones are zero.
+  const auto three = [](std::vector<double>& out, const Vec<Dim>& v) {
+    out.insert(out.end(), {v[0], v[1], Dim == 3 ? v[Dim - 1] : 0.0});
+  };
   for (std::size_t i = 0; i < n; ++i) {
-    xyz.insert(xyz.end(), {p.x[i].x(), p.x[i].y(), 0.0});
-    velocity.insert(velocity.end(), {p.v[i].x(), p.v[i].y(), 0.0});
-    const Vec<2> u = p.x[i] - p.x0[i];
-    displacement.insert(displacement.end(), {u.x(), u.y(), 0.0});
-    const Mat<2>& s = p.stress[i];
-    stress.insert(stress.end(), {s(0, 0), s(0, 1), 0.0, s(1, 1), 0.0, p.stress_zz[i]});
-    const auto [hi, lo] = principal_extremes(s, p.stress_zz[i]);
+    three(xyz, p.x[i]);
+    three(velocity, p.v[i]);
+    three(displacement, p.x[i] - p.x0[i]);
+    const Mat<Dim>& s = p.stress[i];
+    const double zz = Dim == 2 ? p.stress_zz[i] : 0.0;
+    if constexpr (Dim == 2)
+      stress.insert(stress.end(), {s(0, 0), s(0, 1), 0.0, s(1, 1), 0.0, zz});
+    else
+      stress.insert(stress.end(), {s(0, 0), s(0, 1), s(0, 2), s(1, 1), s(1, 2), s(2, 2)});
+    const auto [hi, lo] = principal_extremes<Dim>(s, zz);
     s_max.push_back(hi);
     s_min.push_back(lo);
   }
@@ -88,7 +123,7 @@ void Output::snapshot(const Solver& solver) {
   snap.add("particles", {"sigma_min", output::Center::node, 1, "Pa", std::move(s_min)});
   // The particles' own scalar fields, as their table says.
   p.for_each_field([&](const auto& field, const auto& values) {
-    using Written = Particles<2>::Written;
+    using Written = typename Particles<Dim>::Written;
     if constexpr (std::is_arithmetic_v<typename std::decay_t<decltype(values)>::value_type>) {
       if (field.written == Written::never || (values.empty() && field.written == Written::when_present)) return;
       std::vector<double> shown(n, field.fill);
@@ -99,7 +134,8 @@ void Output::snapshot(const Solver& solver) {
   series_.write(snap);
 }
 
-void Output::history(const Solver& solver, const StepInfo& step) {
+template <int Dim>
+void Output<Dim>::history(const Solver<Dim>& solver, const StepInfo& step) {
   const Energies e = solver.energies();
   if (!initial_total_) initial_total_ = e.total();
   audit_.record(e, solver.time());
@@ -116,11 +152,12 @@ void Output::history(const Solver& solver, const StepInfo& step) {
   for (std::size_t i = 0; i < p.size(); ++i) {
     const auto found = std::find(tracers_.begin(), tracers_.end(), p.id[i]);
     if (found == tracers_.end()) continue;
-    const Vec<2> u = p.x[i] - p.x0[i];
-    const auto [hi, lo] = principal_extremes(p.stress[i], p.stress_zz[i]);
-    tracer_file_ << fmt::format("{:.10g},{},{},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.6g},{:.6g}\n",
-                                solver.time(), found - tracers_.begin(), p.id[i], p.x[i].x(), p.x[i].y(), p.v[i].x(),
-                                p.v[i].y(), p.v[i].norm(), u.x(), u.y(), hi, lo,
+    const Vec<Dim> u = p.x[i] - p.x0[i];
+    const auto [hi, lo] = principal_extremes<Dim>(p.stress[i], Dim == 2 ? p.stress_zz[i] : 0.0);
+    const auto components = [](const Vec<Dim>& v) { return fmt::format("{:.10g}", fmt::join(v, ",")); };
+    tracer_file_ << fmt::format("{:.10g},{},{},{},{},{:.10g},{},{:.10g},{:.10g},{:.6g},{:.6g}\n", solver.time(),
+                                found - tracers_.begin(), p.id[i], components(p.x[i]), components(p.v[i]),
+                                p.v[i].norm(), components(u), hi, lo,
                                 p.plastic_strain.empty() ? 0.0 : p.plastic_strain[i],
                                 p.damage.empty() ? 0.0 : p.damage[i]);
   }
@@ -128,21 +165,26 @@ void Output::history(const Solver& solver, const StepInfo& step) {
   if (!tracer_file_) throw std::runtime_error("cannot write tracers.csv: the disk may be full");
 }
 
-void Output::finish() const {
+template <int Dim>
+void Output<Dim>::finish() const {
   const double open = audit_.open_share(), step = audit_.integration_share();
+  const char* unit = Dim == 2 ? "J/m" : "J";
   if (open > 0.01)
-    spdlog::warn("the energy budget is open by {:.2g} % of its largest term ({:.3g} J/m) at t = {:.4g} s: a "
+    spdlog::warn("the energy budget is open by {:.2g} % of its largest term ({:.3g} {}) at t = {:.4g} s: a "
                  "velocity changed where no book sees it, which is a defect of the solver; please report it with "
                  "the scene (mpm_solid/README.md, Energies; mpm_history.csv)",
-                 100 * open, audit_.largest_term(), audit_.worst_time());
+                 100 * open, audit_.largest_term(), unit, audit_.worst_time());
   else
-    spdlog::info("energy budget closed to {:.2g} % of its largest term ({:.3g} J/m); the time step's own error at "
+    spdlog::info("energy budget closed to {:.2g} % of its largest term ({:.3g} {}); the time step's own error at "
                  "most {:.2g} %",
-                 100 * open, audit_.largest_term(), 100 * step);
+                 100 * open, audit_.largest_term(), unit, 100 * step);
   if (step > integration_warning)
-    spdlog::warn("the time step's own energy error reached {:.2g} % of the largest term ({:.3g} J/m): a step too "
-                 "close to the stable one, or a run gone unstable (integration_J_per_m in mpm_history.csv)",
-                 100 * step, audit_.largest_term());
+    spdlog::warn("the time step's own energy error reached {:.2g} % of the largest term ({:.3g} {}): a step too "
+                 "close to the stable one, or a run gone unstable (integration_{} in mpm_history.csv)",
+                 100 * step, audit_.largest_term(), unit, Dim == 2 ? "J_per_m" : "J");
 }
+
+template class Output<2>;
+template class Output<3>;
 
 }  // namespace outburst::mpm

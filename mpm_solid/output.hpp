@@ -13,9 +13,14 @@
 
 namespace outburst::mpm {
 
-// Largest and smallest principal stress of a plane-strain state (zz included).
-std::pair<double, double> principal_extremes(const Mat<2>& s, double s_zz);
+// Largest and smallest principal stress: of a plane-strain state (zz
+// included) in 2D, of the matrix in 3D (s_zz unused).
+template <int Dim>
+std::pair<double, double> principal_extremes(const Mat<Dim>& s, double s_zz);
 
+// The histories' energies are per metre of depth in 2D (J_per_m columns), whole
+// in 3D (J).
+template <int Dim>
 class Output {
  public:
   // `tracers`: ids of particles whose state is written every step to tracers.csv.
@@ -23,8 +28,8 @@ class Output {
   // cut the histories back to the checkpoint.
   Output(const std::filesystem::path& directory, const output::RunInfo& info, std::vector<int> tracers,
          bool resume = false);
-  void snapshot(const Solver& solver);
-  void history(const Solver& solver, const StepInfo& step);
+  void snapshot(const Solver<Dim>& solver);
+  void history(const Solver<Dim>& solver, const StepInfo& step);
   const output::FieldSeries& series() const { return series_; }
   output::FieldSeries& series() { return series_; }
   // The energy books of the histories written so far; at the end of a run,

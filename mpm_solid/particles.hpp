@@ -20,12 +20,12 @@ struct Particles {
   std::vector<Vec<Dim>> x;                  // position [m]
   std::vector<Vec<Dim>> x0;                 // initial position [m]
   std::vector<Vec<Dim>> v;                  // velocity [m/s]
-  std::vector<double> mass;                 // [kg per m of depth in 2D]
-  std::vector<double> volume;               // current [m^3 per m]
+  std::vector<double> mass;                 // [kg; per m of depth in 2D]
+  std::vector<double> volume;               // current [m^3; m^2 in 2D]
   std::vector<double> volume0;              // initial
   std::vector<double> half_width;           // initial half-width in cells (GIMP)
   std::vector<Mat<Dim>> stress;             // Cauchy, tension positive [Pa]
-  std::vector<double> stress_zz;            // out-of-plane stress (plane strain)
+  std::vector<double> stress_zz;            // out-of-plane stress (plane strain; 3D: absent)
   std::vector<Mat<Dim>> velocity_gradient;  // L = grad v of the last step [1/s]
   std::vector<Mat<Dim>> deformation;        // F
   std::vector<Mat<Dim>> affine;             // APIC's B matrix
@@ -72,7 +72,11 @@ struct Particles {
     double fill = 0;                           // a created scalar field's value, without starts_as
     Written written = Written::never;
     const char* unit = "";                     // of a written field
+    // Plane strain's out-of-plane stress: a 3D stress matrix holds it, and
+    // 3D particles have no such field.
+    bool plane_only = false;
     bool optional() const { return effect != nullptr; }
+    bool present() const { return Dim == 2 || !plane_only; }
   };
   static constexpr auto fields() {
     using P = Particles;
@@ -80,7 +84,8 @@ struct Particles {
         Field<Vec<Dim>>{"x", &P::x}, Field<Vec<Dim>>{"x0", &P::x0}, Field<Vec<Dim>>{"v", &P::v},
         Field<double>{"mass", &P::mass}, Field<double>{"volume", &P::volume},
         Field<double>{"volume0", &P::volume0}, Field<double>{"half_width", &P::half_width},
-        Field<Mat<Dim>>{"stress", &P::stress}, Field<double>{"stress_zz", &P::stress_zz},
+        Field<Mat<Dim>>{"stress", &P::stress},
+        Field<double>{.name = "stress_zz", .values = &P::stress_zz, .plane_only = true},
         Field<Mat<Dim>>{"velocity_gradient", &P::velocity_gradient},
         Field<Mat<Dim>>{"deformation", &P::deformation}, Field<Mat<Dim>>{"affine", &P::affine},
         Field<std::int32_t>{.name = "material", .values = &P::material, .written = Written::always},
@@ -92,7 +97,8 @@ struct Particles {
                       .written = Written::always},
         Field<double>{.name = "damage", .values = &P::damage, .effect = "damage", .written = Written::always},
         Field<Mat<Dim>>{"effective_stress", &P::effective_stress, "damage", &P::stress},
-        Field<double>{"effective_stress_zz", &P::effective_stress_zz, "damage", &P::stress_zz},
+        Field<double>{.name = "effective_stress_zz", .values = &P::effective_stress_zz, .effect = "damage",
+                      .starts_as = &P::stress_zz, .plane_only = true},
         Field<double>{.name = "strength_scale", .values = &P::strength_scale, .effect = "heterogeneity",
                       .fill = 1.0, .written = Written::when_present},
         Field<double>{.name = "modulus_scale", .values = &P::modulus_scale, .effect = "heterogeneity",
@@ -100,13 +106,16 @@ struct Particles {
         Field<double>{.name = "nonlocal_strain", .values = &P::nonlocal_strain, .effect = "nonlocal damage",
                       .written = Written::when_present});
   }
+  // f(field, values) over the fields of this dimension.
   template <class F>
   void for_each_field(F&& f) {
-    std::apply([&](const auto&... field) { (f(field, this->*field.values), ...); }, fields());
+    std::apply([&](const auto&... field) { ((field.present() ? (void)f(field, this->*field.values) : void()), ...); },
+               fields());
   }
   template <class F>
   void for_each_field(F&& f) const {
-    std::apply([&](const auto&... field) { (f(field, this->*field.values), ...); }, fields());
+    std::apply([&](const auto&... field) { ((field.present() ? (void)f(field, this->*field.values) : void()), ...); },
+               fields());
   }
 
   // Creates the optional fields of an effect, at their initial values, if
@@ -162,6 +171,7 @@ struct Particles {
     });
   }
 
+  // initial_stress_zz: plane strain's out-of-plane stress (ignored in 3D).
   void add(const Vec<Dim>& position, const Vec<Dim>& velocity, double particle_mass,
            double particle_volume, double half_width_cells, const Mat<Dim>& initial_stress,
            double initial_stress_zz, int material_index) {
@@ -173,7 +183,7 @@ struct Particles {
     volume0.push_back(particle_volume);
     half_width.push_back(half_width_cells);
     stress.push_back(initial_stress);
-    stress_zz.push_back(initial_stress_zz);
+    if constexpr (Dim == 2) stress_zz.push_back(initial_stress_zz);
     velocity_gradient.push_back(Mat<Dim>::Zero());
     deformation.push_back(Mat<Dim>::Identity());
     affine.push_back(Mat<Dim>::Zero());
@@ -234,5 +244,7 @@ struct Particles {
 // checkpoints.
 static_assert(sizeof(Particles<2>) ==
               std::tuple_size_v<decltype(Particles<2>::fields())> * sizeof(std::vector<double>));
+static_assert(sizeof(Particles<3>) ==
+              std::tuple_size_v<decltype(Particles<3>::fields())> * sizeof(std::vector<double>));
 
 }  // namespace outburst::mpm

@@ -16,10 +16,7 @@ namespace outburst::mpm {
 
 namespace {
 
-template <class Shape>
-using Stencil2 = Stencil<2, Shape>;
-
-using Runs = std::vector<ActiveBlocks::Run>;
+using Runs = std::vector<NodeRun>;
 
 // Runs f(i) over the nodes of the runs, in parallel.
 template <class F>
@@ -88,48 +85,56 @@ constexpr bool lean_build = false;
 // is not forwarded to a wider load): 6 % of a B-spline step.
 
 // L = grad v at a particle, from the grid's velocities, into l.
-template <class Shape>
-[[gnu::always_inline]] inline void velocity_gradient_at(const std::vector<Vec<2>>& velocity,
-                                                        const Stencil2<Shape>& s, Mat<2>& l) {
-  Vec<2> dx = Vec<2>::Zero(), dy = Vec<2>::Zero();  // d v / dx, d v / dy
+template <int Dim, class Shape>
+[[gnu::always_inline]] inline void velocity_gradient_at(const std::vector<Vec<Dim>>& velocity,
+                                                        const Stencil<Dim, Shape>& s, Mat<Dim>& l) {
+  std::array<Vec<Dim>, Dim> along;  // d v / d x_d
+  along.fill(Vec<Dim>::Zero());
   for (int k = 0; k < s.count; ++k) {
-    const Vec<2>& v = velocity[s.node[k]];
-    dx += v * s.gradient[0][k];
-    dy += v * s.gradient[1][k];
+    const Vec<Dim>& v = velocity[s.node[k]];
+    for (int d = 0; d < Dim; ++d) along[d] += v * s.gradient[d][k];
   }
-  l.col(0) = dx;
-  l.col(1) = dy;
+  for (int d = 0; d < Dim; ++d) l.col(d) = along[d];
 }
 
 // What a step's nodal forces take from the particles, decided once per pass:
 // a scene without gravity or loads skips the body-force term altogether.
+template <int Dim>
 struct ForceTerms {
-  Vec<2> gravity;
+  Vec<Dim> gravity;
   const double* pore;  // alpha p, or null
   bool loads, body_forces;
 };
 
-ForceTerms force_terms(const Particles<2>& p, const Settings& settings) {
-  const Vec<2> g = settings.gravity;
+template <int Dim>
+ForceTerms<Dim> force_terms(const Particles<Dim>& p, const Settings<Dim>& settings) {
+  const Vec<Dim> g = settings.gravity;
   const bool loads = !lean_build && !p.external_force.empty();
   return {g, lean_build || p.pore_pressure.empty() ? nullptr : p.pore_pressure.data(), loads,
           !lean_build && (loads || g.squaredNorm() > 0)};
 }
 
 // Adds particle i's internal and body forces to the nodes of its stencil.
-template <class Shape>
-[[gnu::always_inline]] inline void add_forces(const Particles<2>& p, const ForceTerms& t, int i,
-                                              const Stencil2<Shape>& s, std::vector<Vec<2>>& f) {
-  Mat<2> vs = p.volume[i] * p.stress[i];
+template <int Dim, class Shape>
+[[gnu::always_inline]] inline void add_forces(const Particles<Dim>& p, const ForceTerms<Dim>& t, int i,
+                                              const Stencil<Dim, Shape>& s, std::vector<Vec<Dim>>& f) {
+  Mat<Dim> vs = p.volume[i] * p.stress[i];
   if (t.pore) vs.diagonal().array() -= p.volume[i] * t.pore[i];
   if (!t.body_forces) {
-    for (int k = 0; k < s.count; ++k) f[s.node[k]] -= vs.col(0) * s.gradient[0][k] + vs.col(1) * s.gradient[1][k];
+    for (int k = 0; k < s.count; ++k) {
+      Vec<Dim> internal = vs.col(0) * s.gradient[0][k];
+      for (int d = 1; d < Dim; ++d) internal += vs.col(d) * s.gradient[d][k];
+      f[s.node[k]] -= internal;
+    }
     return;
   }
-  const Vec<2> body = t.loads ? Vec<2>(p.mass[i] * t.gravity + p.external_force[i] + p.surface_force[i])
-                              : Vec<2>(p.mass[i] * t.gravity);
-  for (int k = 0; k < s.count; ++k)
-    f[s.node[k]] += s.weight[k] * body - vs.col(0) * s.gradient[0][k] - vs.col(1) * s.gradient[1][k];
+  const Vec<Dim> body = t.loads ? Vec<Dim>(p.mass[i] * t.gravity + p.external_force[i] + p.surface_force[i])
+                                : Vec<Dim>(p.mass[i] * t.gravity);
+  for (int k = 0; k < s.count; ++k) {
+    Vec<Dim> total = s.weight[k] * body;
+    for (int d = 0; d < Dim; ++d) total -= vs.col(d) * s.gradient[d][k];
+    f[s.node[k]] += total;
+  }
 }
 
 void refuse_in_lean_build(bool named, const char* what) {
@@ -141,17 +146,18 @@ void refuse_in_lean_build(bool named, const char* what) {
 // Friction walls act only on nodes moving into them: the normal velocity is
 // removed and the tangential one reduced by mu times that change. Returns the
 // work done by friction (fixed and roller walls do none: the wall does not move).
-double constrain(Vec<2>& v, const Vec<2>& n, const Wall& wall, double mass) {
+template <int Dim>
+double constrain(Vec<Dim>& v, const Vec<Dim>& n, const Wall& wall, double mass) {
   const double vn = v.dot(n);
   switch (wall.type) {
     case Wall::Type::fixed: v.setZero(); return 0;
     case Wall::Type::roller: v -= vn * n; return 0;
     case Wall::Type::friction: {
       if (vn <= 0) return 0;  // separating
-      const Vec<2> vt = v - vn * n;
+      const Vec<Dim> vt = v - vn * n;
       const double slip = vt.norm();
       const double reduced = std::max(slip - wall.friction * vn, 0.0);
-      v = slip > 0 ? Vec<2>(vt * (reduced / slip)) : Vec<2>::Zero();
+      v = slip > 0 ? Vec<Dim>(vt * (reduced / slip)) : Vec<Dim>::Zero();
       // Work of the friction impulse m (|v_t| - reduced) against the sliding.
       return mass * (slip - reduced) * reduced;
     }
@@ -160,7 +166,8 @@ double constrain(Vec<2>& v, const Vec<2>& n, const Wall& wall, double mass) {
   return 0;
 }
 
-std::vector<double> p_moduli(const std::vector<std::unique_ptr<Material>>& materials) {
+template <int Dim>
+std::vector<double> p_moduli(const std::vector<std::unique_ptr<Material<Dim>>>& materials) {
   std::vector<double> m;
   for (const auto& material : materials) m.push_back(material->lame_lambda() + 2 * material->shear_modulus());
   return m;
@@ -170,7 +177,8 @@ std::vector<double> p_moduli(const std::vector<std::unique_ptr<Material>>& mater
 // material compresses (density rises) and with a heterogeneous material's
 // draw of the moduli, plus its own speed. One expression for the stable
 // step's pass and the move's census, so the two agree to the bit.
-[[gnu::always_inline]] inline double signal_speed(const std::vector<double>& p_modulus, const Particles<2>& p,
+template <int Dim>
+[[gnu::always_inline]] inline double signal_speed(const std::vector<double>& p_modulus, const Particles<Dim>& p,
                                                   int i) {
   const double density = p.mass[i] / p.volume[i];
   const double stiffness = p.modulus_scale.empty() ? 1.0 : p.modulus_scale[i];
@@ -179,16 +187,17 @@ std::vector<double> p_moduli(const std::vector<std::unique_ptr<Material>>& mater
 
 }  // namespace
 
-Solver::Solver(Grid<2> grid, std::vector<std::unique_ptr<Material>> materials,
-               Particles<2> particles, Settings settings)
+template <int Dim>
+Solver<Dim>::Solver(Grid<Dim> grid, std::vector<std::unique_ptr<Material<Dim>>> materials,
+                    Particles<Dim> particles, Settings<Dim> settings)
     : grid_(grid),
       materials_(std::move(materials)),
       particles_(std::move(particles)),
       settings_(settings),
       active_(grid_,
               [&] {
-                std::array<bool, 4> mirrored{};
-                for (int side = 0; side < 4; ++side)
+                std::array<bool, 2 * Dim> mirrored{};
+                for (int side = 0; side < 2 * Dim; ++side)
                   mirrored[side] = settings.walls[side].type == Wall::Type::fixed ||
                                    settings.walls[side].type == Wall::Type::roller;
                 return mirrored;
@@ -197,18 +206,24 @@ Solver::Solver(Grid<2> grid, std::vector<std::unique_ptr<Material>> materials,
   if (particles_.size() == 0) throw std::invalid_argument("the scene creates no particles");
   const std::size_t n = grid_.num_nodes();
   mass_.assign(n, 0.0);
-  for (auto* v : {&momentum_, &force_, &velocity_, &velocity_new_}) v->assign(n, Vec<2>::Zero());
+  for (auto* v : {&momentum_, &force_, &velocity_, &velocity_new_}) v->assign(n, Vec<Dim>::Zero());
   threads_ = omp_get_max_threads();
   thread_mass_.assign(static_cast<std::size_t>(threads_ - 1), std::vector<double>(n, 0.0));
-  thread_vector_.assign(static_cast<std::size_t>(threads_ - 1), std::vector<Vec<2>>(n, Vec<2>::Zero()));
+  thread_vector_.assign(static_cast<std::size_t>(threads_ - 1), std::vector<Vec<Dim>>(n, Vec<Dim>::Zero()));
   node_ij_.resize(n);
-  for (int j = 0; j < grid_.nodes_along(1); ++j)
-    for (int i = 0; i < grid_.nodes_along(0); ++i) node_ij_[grid_.index({i, j})] = {i, j};
+  for (std::size_t flat = 0; flat < n; ++flat) {
+    std::size_t rest = flat;
+    for (int d = 0; d < Dim; ++d) {
+      const auto along = static_cast<std::size_t>(grid_.nodes_along(d));
+      node_ij_[flat][d] = static_cast<int>(rest % along);
+      rest /= along;
+    }
+  }
   counted_.assign(n, 1);
-  for (int side = 0; side < 4; ++side) {
+  for (int side = 0; side < 2 * Dim; ++side) {
     const auto type = settings_.walls[side].type;
     if (type != Wall::Type::fixed && type != Wall::Type::roller) continue;
-    const int axis = side / 2, g = Grid<2>::ghost;
+    const int axis = side / 2, g = Grid<Dim>::ghost;
     const int wall_row = side % 2 == 0 ? g : g + grid_.cells[axis];
     for (std::size_t i = 0; i < n; ++i)
       if (side % 2 == 0 ? node_ij_[i][axis] < wall_row : node_ij_[i][axis] > wall_row) counted_[i] = 0;
@@ -222,12 +237,12 @@ Solver::Solver(Grid<2> grid, std::vector<std::unique_ptr<Material>> materials,
   rebuild_material_groups();
   for (std::size_t m = 0; m < materials_.size(); ++m) materials_[m]->create_fields(particles_, members_[m]);
   find_obstacle_nodes();
-  for (const Platen& platen : settings_.platens) {
+  for (const Platen<Dim>& platen : settings_.platens) {
     if (!(platen.upper.array() > platen.lower.array()).all())
       throw std::invalid_argument("a platen's upper corner must lie above and right of its lower corner");
     auto& nodes = platen_nodes_.emplace_back();
     for (std::size_t i = 0; i < node_ij_.size(); ++i) {
-      const Vec<2> x = grid_.node_position(node_ij_[i]);
+      const Vec<Dim> x = grid_.node_position(node_ij_[i]);
       if ((x.array() >= platen.lower.array()).all() && (x.array() <= platen.upper.array()).all()) nodes.push_back(i);
     }
     if (nodes.empty()) throw std::invalid_argument("a platen's box holds no grid node");
@@ -241,7 +256,8 @@ Solver::Solver(Grid<2> grid, std::vector<std::unique_ptr<Material>> materials,
 
   // One kernel per (shape, scheme), chosen here once.
   const auto with_transfer = [&]<class Shape, Scheme S>() -> void (Solver::*)(double) {
-    return settings_.apic ? &Solver::step_kernel<Shape, S, true> : &Solver::step_kernel<Shape, S, false>;
+    return settings_.apic ? &Solver::template step_kernel<Shape, S, true>
+                          : &Solver::template step_kernel<Shape, S, false>;
   };
   const auto pick = [&]<class Shape>() -> void (Solver::*)(double) {
     switch (settings_.scheme) {
@@ -258,43 +274,50 @@ Solver::Solver(Grid<2> grid, std::vector<std::unique_ptr<Material>> materials,
   }
 }
 
-void Solver::find_obstacle_nodes() {
+template <int Dim>
+void Solver<Dim>::find_obstacle_nodes() {
   const double tolerance = 1e-9 * grid_.h;
   obstacle_nodes_.clear();
   for (std::size_t k = 0; k < settings_.obstacles.size(); ++k) {
-    const Obstacle& o = settings_.obstacles[k];
+    const Obstacle<Dim>& o = settings_.obstacles[k];
     if (!(o.upper.array() > o.lower.array()).all())
       throw std::invalid_argument("an obstacle's upper corner must lie above and right of its lower corner");
     for (std::size_t i = 0; i < node_ij_.size(); ++i) {
-      const Vec<2> x = grid_.node_position(node_ij_[i]);
+      const Vec<Dim> x = grid_.node_position(node_ij_[i]);
       if ((x.array() < o.lower.array() - tolerance).any() || (x.array() > o.upper.array() + tolerance).any())
         continue;
-      // Distances to the left, right, bottom and top faces; the nearest sets
-      // the normal, and a corner (two nearest) takes their diagonal.
-      const std::array<double, 4> distance{x.x() - o.lower.x(), o.upper.x() - x.x(), x.y() - o.lower.y(),
-                                           o.upper.y() - x.y()};
-      const std::array<Vec<2>, 4> inward{Vec<2>(1, 0), Vec<2>(-1, 0), Vec<2>(0, 1), Vec<2>(0, -1)};
+      // Distances to the faces (left, right, bottom, top, and in 3D back,
+      // front); the nearest sets the normal, and an edge or a corner (two or
+      // three nearest) takes their diagonal.
+      std::array<double, 2 * Dim> distance;
+      for (int d = 0; d < Dim; ++d) {
+        distance[2 * d] = x[d] - o.lower[d];
+        distance[2 * d + 1] = o.upper[d] - x[d];
+      }
       const double nearest = *std::min_element(distance.begin(), distance.end());
-      Vec<2> n = Vec<2>::Zero();
-      for (int f = 0; f < 4; ++f)
-        if (distance[f] <= nearest + tolerance) n += inward[f];
+      Vec<Dim> n = Vec<Dim>::Zero();
+      for (int f = 0; f < 2 * Dim; ++f)
+        if (distance[f] <= nearest + tolerance) n += (f % 2 == 0 ? 1.0 : -1.0) * Vec<Dim>::Unit(f / 2);
       if (n.squaredNorm() == 0) continue;  // the centre of a square obstacle: no material reaches it
       obstacle_nodes_.push_back({i, n.normalized(), k});
     }
   }
 }
 
-std::vector<std::vector<int>> material_members(const Particles<2>& particles, std::size_t materials) {
+template <int Dim>
+std::vector<std::vector<int>> material_members(const Particles<Dim>& particles, std::size_t materials) {
   std::vector<std::vector<int>> members(materials);
   for (std::size_t p = 0; p < particles.size(); ++p)
     members[static_cast<std::size_t>(particles.material[p])].push_back(static_cast<int>(p));
   return members;
 }
 
-void Solver::rebuild_material_groups() { members_ = material_members(particles_, materials_.size()); }
+template <int Dim>
+void Solver<Dim>::rebuild_material_groups() { members_ = material_members(particles_, materials_.size()); }
 
-double stable_time_step(const std::vector<std::unique_ptr<Material>>& materials, const Particles<2>& particles,
-                        double h, double courant) {
+template <int Dim>
+double stable_time_step(const std::vector<std::unique_ptr<Material<Dim>>>& materials,
+                        const Particles<Dim>& particles, double h, double courant) {
   const std::vector<double> p_modulus = p_moduli(materials);
   double fastest = 0;
   const int n = static_cast<int>(particles.size());
@@ -303,27 +326,29 @@ double stable_time_step(const std::vector<std::unique_ptr<Material>>& materials,
   return courant * h / fastest;
 }
 
-double Solver::stable_time_step() const {
+template <int Dim>
+double Solver<Dim>::stable_time_step() const {
   if (fastest_ > 0) return settings_.courant * grid_.h / fastest_;
   return mpm::stable_time_step(materials_, particles_, grid_.h, settings_.courant);
 }
 
+template <int Dim>
 template <class Shape, bool Apic>
-void Solver::scatter_mass_momentum() {
+void Solver<Dim>::scatter_mass_momentum() {
   const auto& p = particles_;
   const int n = static_cast<int>(p.size());
   clear_grid();
   Scatter<double> masses{thread_mass_, mass_, active_.runs()};
-  Scatter<Vec<2>> momenta{thread_vector_, momentum_, active_.runs()};
+  Scatter<Vec<Dim>> momenta{thread_vector_, momentum_, active_.runs()};
   long outside = 0;
 #pragma omp parallel num_threads(threads_) reduction(+ : outside)
   {
     double* m = masses.buffer(omp_get_thread_num()).data();
-    Vec<2>* mv = momenta.buffer(omp_get_thread_num()).data();
+    Vec<Dim>* mv = momenta.buffer(omp_get_thread_num()).data();
     std::uint8_t* reached = active_.marks(omp_get_thread_num());
-    const int blocks_along_x = active_.blocks_along_x();
-    const Lattice<2> lattice(grid_);
-    Stencil2<Shape> s;
+    const auto strides = active_.strides();
+    const Lattice<Dim> lattice(grid_);
+    Stencil<Dim, Shape> s;
 #pragma omp for schedule(static)
     for (int i = 0; i < n; ++i) {
       // Particles leave the grid at the end of a step; one beyond its ghost
@@ -332,11 +357,11 @@ void Solver::scatter_mass_momentum() {
         ++outside;
         continue;
       }
-      ActiveBlocks::set_reached<Shape::support>(reached, blocks_along_x, s.base);
+      ActiveBlocks<Dim>::template set_reached<Shape::support>(reached, strides, s.base);
       // Read once: the compiler cannot tell the nodal sums from the
       // particle's fields, and would load these again after every store.
       const double mass = p.mass[i];
-      const Vec<2> v = p.v[i];
+      const Vec<Dim> v = p.v[i];
       for (int k = 0; k < s.count; ++k) {
         const double wm = s.weight[k] * mass;
         m[s.node[k]] += wm;
@@ -356,30 +381,33 @@ void Solver::scatter_mass_momentum() {
   fold_ghosts(&mass_, momentum_);
 }
 
-std::size_t Solver::stray_nodal_values() const {
+template <int Dim>
+std::size_t Solver<Dim>::stray_nodal_values() const {
   std::vector<char> active(mass_.size(), 0);
   for (const auto& r : active_.runs()) std::fill_n(active.begin() + static_cast<std::ptrdiff_t>(r.first), r.count, 1);
   std::size_t stray = 0;
   for (std::size_t i = 0; i < mass_.size(); ++i) {
     if (!active[i])
-      stray += (mass_[i] != 0) + (momentum_[i] != Vec<2>::Zero()) + (force_[i] != Vec<2>::Zero()) +
-               (velocity_[i] != Vec<2>::Zero()) + (velocity_new_[i] != Vec<2>::Zero());
+      stray += (mass_[i] != 0) + (momentum_[i] != Vec<Dim>::Zero()) + (force_[i] != Vec<Dim>::Zero()) +
+               (velocity_[i] != Vec<Dim>::Zero()) + (velocity_new_[i] != Vec<Dim>::Zero());
     for (const auto& t : thread_mass_) stray += t[i] != 0;
-    for (const auto& t : thread_vector_) stray += t[i] != Vec<2>::Zero();
+    for (const auto& t : thread_vector_) stray += t[i] != Vec<Dim>::Zero();
   }
   return stray;
 }
 
-void Solver::clear_grid() {
+template <int Dim>
+void Solver<Dim>::clear_grid() {
   over_nodes(active_.runs(), [&](std::size_t i) {
     mass_[i] = 0;
-    momentum_[i] = force_[i] = velocity_[i] = velocity_new_[i] = Vec<2>::Zero();
+    momentum_[i] = force_[i] = velocity_[i] = velocity_new_[i] = Vec<Dim>::Zero();
   });
 }
 
-void Solver::grid_velocities() {
+template <int Dim>
+void Solver<Dim>::grid_velocities() {
   over_nodes(active_.runs(), [&](std::size_t i) {
-    velocity_[i] = mass_[i] > empty_node_mass_ ? Vec<2>(momentum_[i] / mass_[i]) : Vec<2>::Zero();
+    velocity_[i] = mass_[i] > empty_node_mass_ ? Vec<Dim>(momentum_[i] / mass_[i]) : Vec<Dim>::Zero();
   });
   apply_platens(velocity_, 0, 0);
   apply_walls(velocity_);
@@ -388,9 +416,10 @@ void Solver::grid_velocities() {
 // A massless plate moves with the momentum of the nodes it holds plus its
 // force's impulse, shared over their mass, or at its set speed, with the force
 // that takes; it moves them all with it.
-void Solver::apply_platens(std::vector<Vec<2>>& velocity, double impulse, double dt) {
+template <int Dim>
+void Solver<Dim>::apply_platens(std::vector<Vec<Dim>>& velocity, double impulse, double dt) {
   for (std::size_t k = 0; k < platen_nodes_.size(); ++k) {
-    const Platen& platen = settings_.platens[k];
+    const Platen<Dim>& platen = settings_.platens[k];
     double mass = 0, momentum = 0;
     for (std::size_t i : platen_nodes_[k])
       if (mass_[i] > empty_node_mass_) {
@@ -408,14 +437,15 @@ void Solver::apply_platens(std::vector<Vec<2>>& velocity, double impulse, double
   }
 }
 
+template <int Dim>
 template <class Shape>
-void Solver::gather_velocity_gradient() {
+void Solver<Dim>::gather_velocity_gradient() {
   auto& p = particles_;
   const int n = static_cast<int>(p.size());
 #pragma omp parallel
   {
-    const Lattice<2> lattice(grid_);
-    Stencil2<Shape> s;
+    const Lattice<Dim> lattice(grid_);
+    Stencil<Dim, Shape> s;
 #pragma omp for schedule(static)
     for (int i = 0; i < n; ++i) {
       s.compute(lattice, p.x[i], p.half_width[i]);
@@ -424,46 +454,50 @@ void Solver::gather_velocity_gradient() {
   }
 }
 
+template <int Dim>
 template <class Shape>
-void Solver::smooth_dilatation() {
+void Solver<Dim>::smooth_dilatation() {
   auto& p = particles_;
   const int n = static_cast<int>(p.size());
-  // Scatter V tr(L) and V into force_, which is free until scatter_forces
-  // rebuilds it.
-  Scatter<Vec<2>> sums{thread_vector_, force_, active_.runs()};
+  // Scatter V tr(L) and V into the first two components of force_, which is
+  // free until scatter_forces rebuilds it.
+  Scatter<Vec<Dim>> sums{thread_vector_, force_, active_.runs()};
   sums.clear();
 #pragma omp parallel num_threads(threads_)
   {
     auto& weighted = sums.buffer(omp_get_thread_num());
-    const Lattice<2> lattice(grid_);
-    Stencil2<Shape> s;
+    const Lattice<Dim> lattice(grid_);
+    Stencil<Dim, Shape> s;
 #pragma omp for schedule(static)
     for (int i = 0; i < n; ++i) {
       s.compute(lattice, p.x[i], p.half_width[i]);
-      const Vec<2> value(p.volume[i] * p.velocity_gradient[i].trace(), p.volume[i]);
+      Vec<Dim> value = Vec<Dim>::Zero();
+      value[0] = p.volume[i] * p.velocity_gradient[i].trace();
+      value[1] = p.volume[i];
       for (int k = 0; k < s.count; ++k) weighted[s.node[k]] += s.weight[k] * value;
     }
   }
   sums.gather();
 #pragma omp parallel
   {
-    const Lattice<2> lattice(grid_);
-    Stencil2<Shape> s;
+    const Lattice<Dim> lattice(grid_);
+    Stencil<Dim, Shape> s;
 #pragma omp for schedule(static)
     for (int i = 0; i < n; ++i) {
       s.compute(lattice, p.x[i], p.half_width[i]);
       double smoothed = 0;
       for (int k = 0; k < s.count; ++k) {
-        const Vec<2>& node = force_[s.node[k]];
+        const Vec<Dim>& node = force_[s.node[k]];
         if (node[1] > 0) smoothed += s.weight[k] * node[0] / node[1];
       }
-      Mat<2>& l = p.velocity_gradient[i];
+      Mat<Dim>& l = p.velocity_gradient[i];
       l.diagonal().array() += 0.5 * (smoothed - l.trace());
     }
   }
 }
 
-void Solver::update_stresses(double dt) {
+template <int Dim>
+void Solver<Dim>::update_stresses(double dt) {
   for (std::size_t m = 0; m < materials_.size(); ++m) {
     const Dissipation d = materials_[m]->update_stress(particles_, members_[m], dt);
     dissipated_.plastic += d.plastic;
@@ -471,18 +505,19 @@ void Solver::update_stresses(double dt) {
   }
 }
 
+template <int Dim>
 template <class Shape>
-void Solver::scatter_forces() {
+void Solver<Dim>::scatter_forces() {
   const auto& p = particles_;
   const int n = static_cast<int>(p.size());
-  const ForceTerms terms = force_terms(p, settings_);
-  Scatter<Vec<2>> forces{thread_vector_, force_, active_.runs()};
+  const ForceTerms<Dim> terms = force_terms(p, settings_);
+  Scatter<Vec<Dim>> forces{thread_vector_, force_, active_.runs()};
   forces.clear();
 #pragma omp parallel num_threads(threads_)
   {
     auto& f = forces.buffer(omp_get_thread_num());
-    const Lattice<2> lattice(grid_);
-    Stencil2<Shape> s;
+    const Lattice<Dim> lattice(grid_);
+    Stencil<Dim, Shape> s;
 #pragma omp for schedule(static)
     for (int i = 0; i < n; ++i) {
       s.compute(lattice, p.x[i], p.half_width[i]);
@@ -500,18 +535,19 @@ void Solver::scatter_forces() {
 // It measures faster under quadratic B-splines and slower under linear
 // shapes, whose stencils cost less to compute than to keep, so those stay on
 // the three passes (mpm_solid/benchmark/compare-c88bc1c-fused.csv).
+template <int Dim>
 template <class Shape>
-void Solver::update_and_scatter(double dt) {
+void Solver<Dim>::update_and_scatter(double dt) {
   auto& p = particles_;
-  const ForceTerms terms = force_terms(p, settings_);
-  Scatter<Vec<2>> forces{thread_vector_, force_, active_.runs()};
+  const ForceTerms<Dim> terms = force_terms(p, settings_);
+  Scatter<Vec<Dim>> forces{thread_vector_, force_, active_.runs()};
   forces.clear();
   double plastic = 0, damage = 0;
 #pragma omp parallel num_threads(threads_) reduction(+ : plastic, damage)
   {
     auto& f = forces.buffer(omp_get_thread_num());
-    const Lattice<2> lattice(grid_);
-    std::vector<Stencil2<Shape>> stencils(chunk_size);
+    const Lattice<Dim> lattice(grid_);
+    std::vector<Stencil<Dim, Shape>> stencils(chunk_size);
     for (std::size_t m = 0; m < materials_.size(); ++m) {
       const std::span<const int> members(members_[m]);
       const int n = static_cast<int>(members.size()), chunks = (n + chunk_size - 1) / chunk_size;
@@ -537,12 +573,13 @@ void Solver::update_and_scatter(double dt) {
   fold_ghosts(nullptr, force_);
 }
 
-void Solver::grid_update(double dt) {
+template <int Dim>
+void Solver<Dim>::grid_update(double dt) {
   const Runs& runs = active_.runs();
   if (const double alpha = settings_.local_damping; alpha > 0) {
     dissipated_.damping += sum_over_nodes(runs, [&](std::size_t i) {
       double work = 0;
-      for (int d = 0; d < 2; ++d)
+      for (int d = 0; d < Dim; ++d)
         if (velocity_[i][d] != 0) {
           const double damping = alpha * std::abs(force_[i][d]);
           force_[i][d] -= damping * std::copysign(1.0, velocity_[i][d]);
@@ -557,7 +594,7 @@ void Solver::grid_update(double dt) {
   const double c = settings_.viscous_damping, shrink = 1 / (1 + c * dt);
   over_nodes(runs, [&](std::size_t i) {
     velocity_new_[i] =
-        mass_[i] > empty_node_mass_ ? Vec<2>(shrink * (velocity_[i] + dt * force_[i] / mass_[i])) : Vec<2>::Zero();
+        mass_[i] > empty_node_mass_ ? Vec<Dim>(shrink * (velocity_[i] + dt * force_[i] / mass_[i])) : Vec<Dim>::Zero();
   });
   apply_platens(velocity_new_, shrink * dt, dt);  // before the walls: the ghost nodes mirror the plate's motion
   dissipated_.walls += apply_walls(velocity_new_);
@@ -571,7 +608,7 @@ void Solver::grid_update(double dt) {
   for (int r = 0; r < nr; ++r)
     for (std::size_t i = runs[r].first, end = i + static_cast<std::size_t>(runs[r].count); i < end; ++i)
       if (counted_[i]) {
-        const Vec<2> change = velocity_new_[i] - velocity_[i];
+        const Vec<Dim> change = velocity_new_[i] - velocity_[i];
         work += mass_[i] * velocity_[i].dot(change);
         projected += (momentum_[i] - mass_[i] * velocity_[i]).dot(change);
       }
@@ -592,27 +629,44 @@ void Solver::grid_update(double dt) {
 // would give the inside node exactly what the real one gives the ghost node,
 // reflected. Without this the nodes next to a wall miss their images' share and
 // wide shape functions (B-splines reach 1.5 cells) lose an order of accuracy.
-void Solver::fold_ghosts(std::vector<double>* mass, std::vector<Vec<2>>& vectors) const {
-  const int g = Grid<2>::ghost;
-  for (int side = 0; side < 4; ++side) {
+template <int Dim>
+template <class F>
+void Solver<Dim>::over_layer(int axis, int row, F&& f) const {
+  std::array<int, Dim> ij{};
+  ij[axis] = row;
+  const int a = axis == 0 ? 1 : 0, b = axis == 2 ? 1 : 2;  // the other axes (b: 3D only)
+  const int layers = Dim == 2 ? 1 : grid_.nodes_along(b);
+  for (int l = 0; l < layers; ++l) {
+    if constexpr (Dim == 3) ij[b] = l;
+    for (int k = 0; k < grid_.nodes_along(a); ++k) {
+      ij[a] = k;
+      f(ij);
+    }
+  }
+}
+
+template <int Dim>
+void Solver<Dim>::fold_ghosts(std::vector<double>* mass, std::vector<Vec<Dim>>& vectors) const {
+  const int g = Grid<Dim>::ghost;
+  for (int side = 0; side < 2 * Dim; ++side) {
     const Wall& wall = settings_.walls[side];
     if (wall.type != Wall::Type::fixed && wall.type != Wall::Type::roller) continue;
-    const int axis = side / 2, t = 1 - axis;
+    const int axis = side / 2;
     const int outward = side % 2 == 0 ? -1 : 1;
     const int wall_row = outward < 0 ? g : g + grid_.cells[axis];
     const double tangential = wall.type == Wall::Type::fixed ? -1.0 : 1.0;
-    for (int depth = 1; depth <= g; ++depth) {
-      std::array<int, 2> ghost{}, mirror{};
-      ghost[axis] = wall_row + depth * outward;
-      mirror[axis] = wall_row - depth * outward;
-      for (int k = 0; k < grid_.nodes_along(t); ++k) {
-        ghost[t] = mirror[t] = k;
+    for (int depth = 1; depth <= g; ++depth)
+      over_layer(axis, wall_row + depth * outward, [&](const std::array<int, Dim>& ghost) {
+        std::array<int, Dim> mirror = ghost;
+        mirror[axis] = wall_row - depth * outward;
         const std::size_t from = grid_.index(ghost), to = grid_.index(mirror);
         if (mass) (*mass)[to] += (*mass)[from];
-        vectors[to][axis] -= vectors[from][axis];
-        vectors[to][t] += tangential * vectors[from][t];
-      }
-    }
+        for (int d = 0; d < Dim; ++d)
+          if (d == axis)
+            vectors[to][d] -= vectors[from][d];
+          else
+            vectors[to][d] += tangential * vectors[from][d];
+      });
   }
 }
 
@@ -622,46 +676,45 @@ void Solver::fold_ghosts(std::vector<double>* mass, std::vector<Vec<2>>& vectors
 // condition at the wall itself and not half a cell inside (which costs wide
 // shape functions a whole order of accuracy). Obstacles follow. Returns the
 // work done by friction.
-double Solver::apply_walls(std::vector<Vec<2>>& velocity) const {
-  const int g = Grid<2>::ghost;
+template <int Dim>
+double Solver<Dim>::apply_walls(std::vector<Vec<Dim>>& velocity) const {
+  const int g = Grid<Dim>::ghost;
   double friction_work = 0;
   // Wall rows first, then ghost rows outward, so that every mirror is final
   // when it is read (thin domains mirror one wall's ghosts in the other's).
   for (int depth = 0; depth <= g; ++depth) {
-    for (int side = 0; side < 4; ++side) {
+    for (int side = 0; side < 2 * Dim; ++side) {
       const Wall& wall = settings_.walls[side];
       if (wall.type == Wall::Type::open) continue;
-      const int axis = side / 2, t = 1 - axis;
+      const int axis = side / 2;
       const int outward = side % 2 == 0 ? -1 : 1;  // wall normal, out of the domain
       const int wall_row = outward < 0 ? g : g + grid_.cells[axis];
-      Vec<2> normal = Vec<2>::Zero();
+      Vec<Dim> normal = Vec<Dim>::Zero();
       normal[axis] = outward;
-      std::array<int, 2> ij{}, mirror{};
-      ij[axis] = wall_row + depth * outward;
-      mirror[axis] = wall_row - depth * outward;
-      for (int k = 0; k < grid_.nodes_along(t); ++k) {
-        ij[t] = mirror[t] = k;
+      over_layer(axis, wall_row + depth * outward, [&](const std::array<int, Dim>& ij) {
         const std::size_t i = grid_.index(ij);
-        Vec<2>& v = velocity[i];
+        Vec<Dim>& v = velocity[i];
         if (depth > 0 && wall.type != Wall::Type::friction) {
-          const Vec<2>& m = velocity[grid_.index(mirror)];
-          v[axis] = -m[axis];
-          v[t] = wall.type == Wall::Type::fixed ? -m[t] : m[t];
-          continue;
+          std::array<int, Dim> mirror = ij;
+          mirror[axis] = wall_row - depth * outward;
+          const Vec<Dim>& m = velocity[grid_.index(mirror)];
+          for (int d = 0; d < Dim; ++d) v[d] = d == axis || wall.type == Wall::Type::fixed ? -m[d] : m[d];
+          return;
         }
         friction_work += constrain(v, normal, wall, mass_[i]);
-      }
+      });
     }
   }
   // Most of an obstacle's nodes lie deep in the rock, where no particle
   // reaches: at rest, which every contact leaves at rest.
   for (const auto& o : obstacle_nodes_)
-    if (const Vec<2>& v = velocity[o.node]; v.x() != 0 || v.y() != 0)
+    if (const Vec<Dim>& v = velocity[o.node]; (v.array() != 0).any())
       friction_work += constrain(velocity[o.node], o.normal, settings_.obstacles[o.obstacle].contact, mass_[o.node]);
   return friction_work;
 }
 
-double Solver::runaway_speed_squared(int i) const {
+template <int Dim>
+double Solver<Dim>::runaway_speed_squared(int i) const {
   // A stiff draw of a heterogeneous material carries a faster wave; a soft one
   // is still stepped at the stiffest particle's step, so it is held to its
   // material's speed.
@@ -671,7 +724,8 @@ double Solver::runaway_speed_squared(int i) const {
 
 // Books a moved particle: the work of a pore pressure on it, and whether it
 // went wrong or left.
-[[gnu::always_inline]] inline void Solver::count(int i, double dt, Census& census) const {
+template <int Dim>
+[[gnu::always_inline]] inline void Solver<Dim>::count(int i, double dt, Census& census) const {
   const auto& p = particles_;
   // A pore pressure does work on the skeleton as it dilates.
   if (!lean_build && !p.pore_pressure.empty())
@@ -690,8 +744,9 @@ double Solver::runaway_speed_squared(int i) const {
 
 // Move means this is the step's last transfer: the particles move right away
 // and are counted (one pass less); otherwise their displacements wait.
+template <int Dim>
 template <class Shape, bool Apic, bool Move>
-void Solver::gather_motion(double dt) {
+void Solver<Dim>::gather_motion(double dt) {
   auto& p = particles_;
   const int n = static_cast<int>(p.size());
   const double flip = settings_.flip_fraction;
@@ -700,19 +755,19 @@ void Solver::gather_motion(double dt) {
   const bool loads = !lean_build && !p.external_force.empty();
 #pragma omp parallel reduction(merge : census) reduction(+ : lost, work, gained)
   {
-    const Lattice<2> lattice(grid_);
-    Stencil2<Shape> s;
+    const Lattice<Dim> lattice(grid_);
+    Stencil<Dim, Shape> s;
 #pragma omp for schedule(static)
     for (int i = 0; i < n; ++i) {
       s.template compute<Apic>(lattice, p.x[i], p.half_width[i]);
-      Vec<2> v_pic = Vec<2>::Zero(), dv = Vec<2>::Zero();
-      Mat<2> b = Mat<2>::Zero();
-      Vec<2> d = Vec<2>::Zero();  // diagonal of D = sum w (x_i - x_p)(x_i - x_p)^T
+      Vec<Dim> v_pic = Vec<Dim>::Zero(), dv = Vec<Dim>::Zero();
+      Mat<Dim> b = Mat<Dim>::Zero();
+      Vec<Dim> d = Vec<Dim>::Zero();  // diagonal of D = sum w (x_i - x_p)(x_i - x_p)^T
       double spread = 0;          // sum w |dv_i|^2
       double affine = 0;          // sum w (C (x_i - x_p)) . dv_i
       for (int k = 0; k < s.count; ++k) {
         const auto node = s.node[k];
-        const Vec<2> change = velocity_new_[node] - velocity_[node];
+        const Vec<Dim> change = velocity_new_[node] - velocity_[node];
         v_pic += s.weight[k] * velocity_new_[node];
         dv += s.weight[k] * change;
         spread += s.weight[k] * change.squaredNorm();
@@ -731,7 +786,7 @@ void Solver::gather_motion(double dt) {
       // what the grid cannot hold (sub-cell velocity differences); the PIC
       // share, and APIC, replace that with the grid's field. All of it is
       // what the transfer takes.
-      const Vec<2> v_flip = p.v[i] + dv;
+      const Vec<Dim> v_flip = p.v[i] + dv;
       gained += 0.5 * p.mass[i] * spread;
       lost += 0.5 * p.mass[i] * (spread - dv.squaredNorm()) + p.mass[i] * affine;
       if constexpr (!Move) displacement_[i] = dt * v_pic;
@@ -739,8 +794,8 @@ void Solver::gather_motion(double dt) {
         // D is diagonal for tensor-product shapes that reproduce linear fields;
         // a particle on a linear-shape node has D = 0 along that axis (and B too).
         p.v[i] = v_pic;
-        for (int c = 0; c < 2; ++c)
-          p.affine[i].col(c) = d[c] > 1e-12 * grid_.h * grid_.h ? Vec<2>(b.col(c) / d[c]) : Vec<2>::Zero();
+        for (int c = 0; c < Dim; ++c)
+          p.affine[i].col(c) = d[c] > 1e-12 * grid_.h * grid_.h ? Vec<Dim>(b.col(c) / d[c]) : Vec<Dim>::Zero();
       } else {
         p.v[i] = flip * v_flip + (1 - flip) * v_pic;
       }
@@ -750,7 +805,7 @@ void Solver::gather_motion(double dt) {
       // changes by f (v + v_new) dt / 2), not its own FLIP-blended one.
       if (loads) work += (p.external_force[i] + p.surface_force[i]).dot(dt * (v_pic - 0.5 * dv));
       if constexpr (Move) {
-        const Vec<2> moved = dt * v_pic;
+        const Vec<Dim> moved = dt * v_pic;
         p.x[i] += moved;
         count(i, dt, census);
       }
@@ -764,8 +819,9 @@ void Solver::gather_motion(double dt) {
 
 // Every transfer of a step uses the particles' positions at its start; they move
 // at the end.
+template <int Dim>
 template <class Shape, Scheme S, bool Apic>
-void Solver::step_kernel(double dt) {
+void Solver<Dim>::step_kernel(double dt) {
   if constexpr (S != Scheme::usf) displacement_.resize(particles_.size());
   scatter_mass_momentum<Shape, Apic>();
   grid_velocities();
@@ -798,7 +854,8 @@ void Solver::step_kernel(double dt) {
   }
 }
 
-Census Solver::move_particles(double dt) {
+template <int Dim>
+Census Solver<Dim>::move_particles(double dt) {
   auto& p = particles_;
   const int n = static_cast<int>(p.size());
   Census census;
@@ -810,7 +867,8 @@ Census Solver::move_particles(double dt) {
   return census;
 }
 
-void Solver::remove_escaped(const Census& census, StepInfo& info) {
+template <int Dim>
+void Solver<Dim>::remove_escaped(const Census& census, StepInfo& info) {
   auto& p = particles_;
   const int n = static_cast<int>(p.size());
   const long bad = census.bad, escaped = census.escaped, runaway = census.runaway;
@@ -856,7 +914,8 @@ void Solver::remove_escaped(const Census& census, StepInfo& info) {
   rebuild_material_groups();
 }
 
-StepInfo Solver::step(double dt) {
+template <int Dim>
+StepInfo Solver<Dim>::step(double dt) {
   StepInfo info{dt};
   if (steps_ == 0) dissipated_.stored_start = stored_energy();  // the books open
   (this->*kernel_)(dt);
@@ -869,19 +928,22 @@ StepInfo Solver::step(double dt) {
   return info;
 }
 
-std::vector<Vec<2>>& Solver::external_force() {
+template <int Dim>
+std::vector<Vec<Dim>>& Solver<Dim>::external_force() {
   refuse_in_lean_build(true, "external forces");
   particles_.need_loads();
   return particles_.external_force;
 }
 
-std::vector<double>& Solver::pore_pressure() {
+template <int Dim>
+std::vector<double>& Solver<Dim>::pore_pressure() {
   refuse_in_lean_build(true, "pore pressure");
   particles_.need_pore_pressure();
   return particles_.pore_pressure;
 }
 
-void Solver::shift_initial_stress(const std::vector<double>& per_particle) {
+template <int Dim>
+void Solver<Dim>::shift_initial_stress(const std::vector<double>& per_particle) {
   if (steps_ > 0) throw std::logic_error("shift_initial_stress: the run has already started");
   if (per_particle.size() != particles_.size())
     throw std::invalid_argument(fmt::format("shift_initial_stress: {} values for {} particles", per_particle.size(),
@@ -890,15 +952,16 @@ void Solver::shift_initial_stress(const std::vector<double>& per_particle) {
   for (std::size_t i = 0; i < p.size(); ++i) {
     const double out_of_plane = 2 * materials_[p.material[i]]->elasticity().poisson_ratio * per_particle[i];
     p.stress[i].diagonal().array() += per_particle[i];
-    p.stress_zz[i] += out_of_plane;
+    if constexpr (Dim == 2) p.stress_zz[i] += out_of_plane;
     if (!p.damage.empty()) {
       p.effective_stress[i].diagonal().array() += per_particle[i];
-      p.effective_stress_zz[i] += out_of_plane;
+      if constexpr (Dim == 2) p.effective_stress_zz[i] += out_of_plane;
     }
   }
 }
 
-std::optional<double> Solver::settle(const Settling& stage, std::optional<double> fixed_step,
+template <int Dim>
+std::optional<double> Solver<Dim>::settle(const Settling& stage, std::optional<double> fixed_step,
                                      const std::function<bool()>& pause) {
   if (settled_) throw std::logic_error("settle: the settling stage is over");
   const double scene_damping = settings_.local_damping;
@@ -924,7 +987,8 @@ std::optional<double> Solver::settle(const Settling& stage, std::optional<double
   return settling_peak_ > 0 ? settling_kinetic_ / settling_peak_ : 0.0;
 }
 
-void Solver::save(checkpoint::Out out) const {
+template <int Dim>
+void Solver<Dim>::save(checkpoint::Out out) const {
   particles_.save(out.group("particles"));
   out.number("time", time_);
   out.count("steps", steps_);
@@ -935,9 +999,10 @@ void Solver::save(checkpoint::Out out) const {
   out.numbers("settling_kinetic", std::vector<double>{settling_peak_, settling_kinetic_});
 }
 
-void Solver::load(const checkpoint::In& in) {
+template <int Dim>
+void Solver<Dim>::load(const checkpoint::In& in) {
   const auto group = in.group("particles");
-  Particles<2> p;
+  Particles<Dim> p;
   p.load(group);
   for (const auto m : p.material)
     if (m < 0 || static_cast<std::size_t>(m) >= materials_.size())
@@ -956,8 +1021,9 @@ void Solver::load(const checkpoint::In& in) {
   if (in.flag("settled") && !settled_) remove_supports();
 }
 
-void Solver::remove_supports() {
-  std::erase_if(settings_.obstacles, [](const Obstacle& o) { return o.support; });
+template <int Dim>
+void Solver<Dim>::remove_supports() {
+  std::erase_if(settings_.obstacles, [](const Obstacle<Dim>& o) { return o.support; });
   find_obstacle_nodes();
   settled_ = true;
 }
@@ -972,7 +1038,8 @@ Energies Energies::load(const checkpoint::In& in, const std::string& name) {
   return {v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8], v[9], v[10], v[11], v[12], v[13]};
 }
 
-void Solver::restore_state(const State& s) {
+template <int Dim>
+void Solver<Dim>::restore_state(const State& s) {
   dissipated_ = s.dissipated;
   time_ = s.time;
   steps_ = s.steps;
@@ -984,7 +1051,8 @@ void Solver::restore_state(const State& s) {
   if (!same_particles) rebuild_material_groups();
 }
 
-double Solver::kinetic_energy() const {
+template <int Dim>
+double Solver<Dim>::kinetic_energy() const {
   const auto& p = particles_;
   const int n = static_cast<int>(p.size());
   double kinetic = 0;
@@ -993,7 +1061,8 @@ double Solver::kinetic_energy() const {
   return kinetic;
 }
 
-Solver::Memory Solver::memory() const {
+template <int Dim>
+typename Solver<Dim>::Memory Solver<Dim>::memory() const {
   const auto bytes = [](const auto& v) { return v.capacity() * sizeof(typename std::decay_t<decltype(v)>::value_type); };
   Memory m{0, 0};
   particles_.for_each_field([&](const auto&, const auto& values) { m.particles += bytes(values); });
@@ -1006,23 +1075,26 @@ Solver::Memory Solver::memory() const {
   return m;
 }
 
-double Solver::gravitational_energy() const {
+template <int Dim>
+double Solver<Dim>::gravitational_energy() const {
   const auto& p = particles_;
   const int n = static_cast<int>(p.size());
-  const Vec<2> g = settings_.gravity;
+  const Vec<Dim> g = settings_.gravity;
   double gravity = 0;
 #pragma omp parallel for schedule(static) reduction(+ : gravity)
   for (int i = 0; i < n; ++i) gravity -= p.mass[i] * g.dot(p.x[i] - grid_.lower);
   return gravity;
 }
 
-double Solver::strain_energy() const {
+template <int Dim>
+double Solver<Dim>::strain_energy() const {
   double strain = 0;
   for (std::size_t m = 0; m < materials_.size(); ++m) strain += materials_[m]->strain_energy(particles_, members_[m]);
   return strain;
 }
 
-Energies Solver::energies() const {
+template <int Dim>
+Energies Solver<Dim>::energies() const {
   Energies e = dissipated_;
   e.strain = strain_energy();
   e.kinetic = kinetic_energy();
@@ -1066,5 +1138,14 @@ void EnergyAudit::record(const Energies& e, double time) {
     worst_time_ = time;
   }
 }
+
+template class Solver<2>;
+template class Solver<3>;
+template std::vector<std::vector<int>> material_members(const Particles<2>&, std::size_t);
+template std::vector<std::vector<int>> material_members(const Particles<3>&, std::size_t);
+template double stable_time_step(const std::vector<std::unique_ptr<Material<2>>>&, const Particles<2>&, double,
+                                 double);
+template double stable_time_step(const std::vector<std::unique_ptr<Material<3>>>&, const Particles<3>&, double,
+                                 double);
 
 }  // namespace outburst::mpm

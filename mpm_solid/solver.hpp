@@ -1,5 +1,6 @@
 #pragma once
-// The explicit material point method on a fixed background grid, 2D plane strain.
+// The explicit material point method on a fixed background grid: 2D plane
+// strain (Dim = 2, quantities per metre of depth) or 3D (Dim = 3), one code.
 //
 // One step (update-stress-first, the paper's section 3; USL and MUSL move the
 // stress update after the grid update):
@@ -46,14 +47,15 @@ struct Wall {
   double friction = 0;  // Coulomb coefficient (friction walls)
 };
 
-// A rigid, fixed rectangle inside the grid (the tunnel's roof and floor rock, a
-// support): grid nodes inside it or on its edges take its contact condition,
-// with the normal of the nearest face. Faces on grid lines act exactly there;
-// others act up to a cell inside the obstacle.
+// A rigid, fixed rectangle (a box in 3D) inside the grid (the tunnel's roof
+// and floor rock, a support): grid nodes inside it or on its faces take its
+// contact condition, with the normal of the nearest face. Faces on grid lines
+// act exactly there; others act up to a cell inside the obstacle.
 // A support holds material only while it settles (the unexcavated face): the
 // dynamic stage starts without it.
+template <int Dim>
 struct Obstacle {
-  Vec<2> lower, upper;
+  Vec<Dim> lower, upper;
   Wall contact{Wall::Type::friction, 0};
   bool support = false;
 };
@@ -62,10 +64,11 @@ struct Obstacle {
 // together along `axis`, pushed by `force` and by what the material beneath
 // pushes back; across that axis they move freely. Unlike a traction, the load
 // shifts toward the stiffer part of the body as it deforms (Mandel's problem).
+template <int Dim>
 struct Platen {
-  Vec<2> lower, upper;
+  Vec<Dim> lower, upper;
   int axis = 1;
-  double force = 0;  // along axis, per metre of depth [N/m]
+  double force = 0;  // along axis [N; N/m in 2D, per metre of depth]
   // Set: the plate moves at this speed along axis [m/s] whatever it takes
   // (displacement control, which can follow a load past its peak); `force`
   // is then unused.
@@ -79,6 +82,7 @@ struct Settling {
   double damping = 0.8;
 };
 
+template <int Dim>
 struct Settings {
   Scheme scheme = Scheme::usf;
   // Quadratic B-splines by default: C1 gradients (no cell-crossing noise when
@@ -90,7 +94,7 @@ struct Settings {
   bool apic = false;
   double flip_fraction = 0.99;
   double courant = 0.3;
-  Vec<2> gravity = Vec<2>::Zero();
+  Vec<Dim> gravity = Vec<Dim>::Zero();
   // Local (Cundall) damping coefficient for quasi-static stages: each nodal
   // force component loses alpha |f| against the node's motion. 0: off.
   double local_damping = 0;
@@ -99,10 +103,11 @@ struct Settings {
   // local damping's sign switch: what an iterated coupling of a quasi-static
   // solid needs. 0: off.
   double viscous_damping = 0;
-  // left, right, bottom, top of the physical domain
-  std::array<Wall, 4> walls;
-  std::vector<Obstacle> obstacles;
-  std::vector<Platen> platens;
+  // left, right, bottom, top (and in 3D back, front) of the physical domain:
+  // the low and high face along each axis in turn
+  std::array<Wall, 2 * Dim> walls;
+  std::vector<Obstacle<Dim>> obstacles;
+  std::vector<Platen<Dim>> platens;
   // Volumetric-locking remedy: replace each particle's dilatation rate tr(L) by
   // its volume-weighted average mapped to the nodes and back (nodal dilatation
   // smoothing), leaving the deviatoric rate alone. Near-incompressible
@@ -118,7 +123,7 @@ class SimulationError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// Energies per metre of depth [J/m]. Stored ones are computed from the current
+// Energies [J; J/m in 2D, per metre of depth]. Stored ones are computed from the current
 // state; dissipated and external ones accumulate over the run. With the
 // gravitational potential measured from the grid's lower edge,
 //   kinetic + strain + gravity + plastic + damage + damping + walls + transfer
@@ -201,18 +206,21 @@ struct Census {
 };
 
 // The indices of each material's particles, in order.
-std::vector<std::vector<int>> material_members(const Particles<2>& particles, std::size_t materials);
+template <int Dim>
+std::vector<std::vector<int>> material_members(const Particles<Dim>& particles, std::size_t materials);
 
 // Largest stable step: courant h / max over particles of (c_p + |v_p|), c_p
 // the P-wave speed of each particle's material at its current density and
 // with its draw of the moduli (a heterogeneous material's modulus_scale).
-double stable_time_step(const std::vector<std::unique_ptr<Material>>& materials, const Particles<2>& particles,
-                        double h, double courant);
+template <int Dim>
+double stable_time_step(const std::vector<std::unique_ptr<Material<Dim>>>& materials,
+                        const Particles<Dim>& particles, double h, double courant);
 
+template <int Dim>
 class Solver {
  public:
-  Solver(Grid<2> grid, std::vector<std::unique_ptr<Material>> materials, Particles<2> particles,
-         Settings settings);
+  Solver(Grid<Dim> grid, std::vector<std::unique_ptr<Material<Dim>>> materials, Particles<Dim> particles,
+         Settings<Dim> settings);
 
   // The free function's step for this solver's particles and grid (as the
   // last step's move found it, or computed afresh).
@@ -224,30 +232,31 @@ class Solver {
   double time() const { return time_; }
   long steps() const { return steps_; }
   std::size_t removed_particles() const { return removed_; }
-  const Grid<2>& grid() const { return grid_; }
-  const Settings& settings() const { return settings_; }
+  const Grid<Dim>& grid() const { return grid_; }
+  const Settings<Dim>& settings() const { return settings_; }
   // Switch local damping on (quasi-static stage) or off (dynamic stage).
   void set_local_damping(double alpha) { settings_.local_damping = alpha; }
-  const std::vector<std::unique_ptr<Material>>& materials() const { return materials_; }
+  const std::vector<std::unique_ptr<Material<Dim>>>& materials() const { return materials_; }
 
   // Read access, and the per-particle external force another program sets.
-  const Particles<2>& particles() const { return particles_; }
+  const Particles<Dim>& particles() const { return particles_; }
   // Created (zero) on first call, with the scene's tractions.
-  std::vector<Vec<2>>& external_force();
+  std::vector<Vec<Dim>>& external_force();
   // The per-particle pore pressure that enters the total stress, created
   // (zero) on first call; scenes that never call it carry no such field.
   std::vector<double>& pore_pressure();
-  // Adds s_p to each particle's in-plane normal stresses before the first
-  // step (alpha p when a coupled scene gives total stresses), and 2 nu s_p to
-  // the out-of-plane one: the initial state stays one of plane strain, whose
-  // sigma_zz = nu (sigma_xx + sigma_yy) holds for the stress the solid feels.
+  // Adds s_p to each particle's normal stresses before the first step (alpha
+  // p when a coupled scene gives total stresses); in 2D to the in-plane ones,
+  // and 2 nu s_p to the out-of-plane one: the initial state stays one of
+  // plane strain, whose sigma_zz = nu (sigma_xx + sigma_yy) holds for the
+  // stress the solid feels.
   void shift_initial_stress(const std::vector<double>& per_particle);
 
   struct State {
     double time;
     long steps;
     std::size_t removed;
-    Particles<2> particles;
+    Particles<Dim> particles;
     Energies dissipated;
     std::vector<double> platen_displacement;
   };
@@ -273,8 +282,8 @@ class Solver {
   // How far each platen has moved along its axis since t = 0 [m].
   const std::vector<double>& platen_displacement() const { return platen_displacement_; }
   // The force each platen exerted on the material in the last step, along its
-  // axis, per metre of depth [N/m]: its load, or the reaction of a plate moved
-  // at a set speed.
+  // axis [N; N/m in 2D]: its load, or the reaction of a plate moved at a set
+  // speed.
   const std::vector<double>& platen_force() const { return platen_force_; }
 
   // The grid nodes the last step's passes ran over (ActiveBlocks).
@@ -292,9 +301,9 @@ class Solver {
   Memory memory() const;
 
   Energies energies() const;
-  double kinetic_energy() const;  // the part of energies() a settling stage watches [J/m]
+  double kinetic_energy() const;  // the part of energies() a settling stage watches [J; J/m in 2D]
   double strain_energy() const;
-  double gravitational_energy() const;  // from the grid's lower edge [J/m]
+  double gravitational_energy() const;  // from the grid's lower corner [J; J/m in 2D]
   double stored_energy() const { return strain_energy() + gravitational_energy(); }
 
  private:
@@ -314,21 +323,25 @@ class Solver {
   void gather_motion(double dt);
   void grid_velocities();
   void grid_update(double dt);
-  double apply_walls(std::vector<Vec<2>>& velocity) const;
-  void apply_platens(std::vector<Vec<2>>& velocity, double impulse, double dt);
+  double apply_walls(std::vector<Vec<Dim>>& velocity) const;
+  void apply_platens(std::vector<Vec<Dim>>& velocity, double impulse, double dt);
   void find_obstacle_nodes();
   void remove_supports();  // the settling stage is over
-  void fold_ghosts(std::vector<double>* mass, std::vector<Vec<2>>& vectors) const;
+  void fold_ghosts(std::vector<double>* mass, std::vector<Vec<Dim>>& vectors) const;
+  // f(node) over the nodes of the layer `row` across `axis` (a row of nodes
+  // in 2D, a plane in 3D), ghosts included.
+  template <class F>
+  void over_layer(int axis, int row, F&& f) const;
   void update_stresses(double dt);
   void count(int i, double dt, Census& census) const;
   Census move_particles(double dt);
   void remove_escaped(const Census& census, StepInfo& info);
   void rebuild_material_groups();
 
-  Grid<2> grid_;
-  std::vector<std::unique_ptr<Material>> materials_;
-  Particles<2> particles_;
-  Settings settings_;
+  Grid<Dim> grid_;
+  std::vector<std::unique_ptr<Material<Dim>>> materials_;
+  Particles<Dim> particles_;
+  Settings<Dim> settings_;
   void (Solver::*kernel_)(double) = nullptr;
   // Every particle's stress update reads only its own fields, and no
   // smoothing of the dilatation runs between the gather and the update: USF
@@ -347,20 +360,20 @@ class Solver {
 
   // Grid fields; per-thread copies of the scattered ones avoid locks.
   std::vector<double> mass_;
-  std::vector<Vec<2>> momentum_, force_, velocity_, velocity_new_;
+  std::vector<Vec<Dim>> momentum_, force_, velocity_, velocity_new_;
   int threads_ = 1;
   std::vector<std::vector<double>> thread_mass_;     // of threads 1, 2, ...
-  std::vector<std::vector<Vec<2>>> thread_vector_;
-  std::vector<std::array<int, 2>> node_ij_;  // grid coordinates of each node
-  ActiveBlocks active_;  // where the nodal arrays may be nonzero
+  std::vector<std::vector<Vec<Dim>>> thread_vector_;
+  std::vector<std::array<int, Dim>> node_ij_;  // grid coordinates of each node
+  ActiveBlocks<Dim> active_;  // where the nodal arrays may be nonzero
   void clear_grid();     // zeroes them there, before a new mapping
   // Nodes whose mass counts once (in the damping's work): not the ghosts
   // beyond a fixed or roller wall, whose share fold_ghosts moved inside.
   std::vector<char> counted_;
-  std::vector<Vec<2>> displacement_;         // of each particle over the step
+  std::vector<Vec<Dim>> displacement_;         // of each particle over the step
   struct ObstacleNode {
     std::size_t node;
-    Vec<2> normal;  // unit, pointing into the obstacle
+    Vec<Dim> normal;  // unit, pointing into the obstacle
     std::size_t obstacle;
   };
   std::vector<ObstacleNode> obstacle_nodes_;

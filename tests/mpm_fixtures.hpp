@@ -2,6 +2,7 @@
 // Small MPM problems built in code for the verification tests.
 
 #include <memory>
+#include <type_traits>
 
 #include "mpm_solid/materials/elastic.hpp"
 #include "mpm_solid/scene_reader.hpp"
@@ -18,21 +19,35 @@ inline mpm::Grid<2> grid(double width, double height, double h) {
   return g;
 }
 
-// A rectangular body of one elastic material.
-inline mpm::Particles<2> block(const mpm::Grid<2>& g, const mpm::Vec<2>& lo, const mpm::Vec<2>& hi,
-                               double density, int per_cell) {
-  std::vector<mpm::Vec<2>> points;
-  mpm::fill_cells(g, per_cell, lo, hi, [](const mpm::Vec<2>&) { return true; }, points);
-  mpm::Particles<2> p;
-  const double volume = (g.h / per_cell) * (g.h / per_cell);
+// A box [0, size] of cubes of side h.
+inline mpm::Grid<3> grid(const mpm::Vec<3>& size, double h) {
+  mpm::Grid<3> g;
+  g.h = h;
+  g.lower = mpm::Vec<3>::Zero();
+  for (int d = 0; d < 3; ++d) {
+    g.cells[d] = static_cast<int>(std::lround(size[d] / h));
+    g.upper[d] = g.cells[d] * h;
+  }
+  return g;
+}
+
+// A rectangular body (a box in 3D) of one material, at rest and unstressed.
+template <int Dim>
+mpm::Particles<Dim> block(const mpm::Grid<Dim>& g, const std::type_identity_t<mpm::Vec<Dim>>& lo,
+                          const std::type_identity_t<mpm::Vec<Dim>>& hi, double density, int per_cell) {
+  std::vector<mpm::Vec<Dim>> points;
+  mpm::fill_cells<Dim>(g, per_cell, lo, hi, [](const mpm::Vec<Dim>&) { return true; }, points);
+  mpm::Particles<Dim> p;
+  const double side = g.h / per_cell, volume = Dim == 2 ? side * side : side * side * side;
   for (const auto& x : points)
-    p.add(x, mpm::Vec<2>::Zero(), density * volume, volume, 0.5 / per_cell, mpm::Mat<2>::Zero(), 0, 0);
+    p.add(x, mpm::Vec<Dim>::Zero(), density * volume, volume, 0.5 / per_cell, mpm::Mat<Dim>::Zero(), 0, 0);
   return p;
 }
 
-inline std::vector<std::unique_ptr<mpm::Material>> elastic(const mpm::Elasticity& e) {
-  std::vector<std::unique_ptr<mpm::Material>> m;
-  m.push_back(std::make_unique<mpm::LinearElastic>("elastic", e));
+template <int Dim = 2>
+std::vector<std::unique_ptr<mpm::Material<Dim>>> elastic(const mpm::Elasticity& e) {
+  std::vector<std::unique_ptr<mpm::Material<Dim>>> m;
+  m.push_back(std::make_unique<mpm::LinearElastic<Dim>>("elastic", e));
   return m;
 }
 

@@ -96,11 +96,11 @@ TEST_CASE("one-way: a column under a linear gas pressure settles to the analytic
   seep.set_initial_pressure(linear);
 
   const mpm::Grid<2> gr = grid(1.0, 11.0, 0.25);
-  mpm::Settings s;
+  mpm::Settings<2> s;
   s.local_damping = 0.7;
   s.walls = {mpm::Wall{mpm::Wall::Type::roller}, mpm::Wall{mpm::Wall::Type::roller},
              mpm::Wall{mpm::Wall::Type::fixed}, mpm::Wall{}};
-  mpm::Solver solid(gr, elastic({rho, E, nu}), block(gr, {0, 0}, {1, H}, rho, 2), s);
+  mpm::Solver<2> solid(gr, elastic({rho, E, nu}), block(gr, {0, 0}, {1, H}, rho, 2), s);
 
   GasSolidSettings gs;
   gs.biot = alpha;

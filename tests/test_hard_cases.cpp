@@ -259,9 +259,9 @@ TEST_CASE("hard: particles leaving the grid at 100 m/s are removed, counted and 
   const auto g = grid(4, 2, 0.1);
   auto particles = block(g, {2.5, 0.5}, {3.5, 1.5}, coal.density, 2);
   for (auto& v : particles.v) v = {100, 0};
-  mpm::Settings s;
+  mpm::Settings<2> s;
   s.gravity = {0, -9.81};
-  mpm::Solver solver(g, elastic(coal), std::move(particles), s);
+  mpm::Solver<2> solver(g, elastic(coal), std::move(particles), s);
   mpm::EnergyAudit audit;
   audit.record(solver.energies(), 0);
   const std::size_t initial = solver.particles().size();

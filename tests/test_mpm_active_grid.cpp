@@ -31,12 +31,12 @@ Run drop(double width, ShapeKind shape, Scheme scheme) {
   const Grid<2> g = grid(width, 2.0, 0.1);
   Particles<2> p = block(g, Vec<2>(0.0, 0.0), Vec<2>(1.0, 0.8), 1000, 2);
   for (auto& v : p.v) v = Vec<2>(2.0, -1.0);
-  Settings s;
+  Settings<2> s;
   s.shape = shape;
   s.scheme = scheme;
   s.gravity = {0, -9.81};
   s.walls = {Wall{Wall::Type::fixed}, Wall{}, Wall{Wall::Type::fixed}, Wall{}};
-  Solver solver(g, elastic({1000, 1e7, 0.3}), std::move(p), s);
+  Solver<2> solver(g, elastic({1000, 1e7, 0.3}), std::move(p), s);
   const double dt = solver.stable_time_step();
   for (int k = 0; k < 300; ++k) solver.step(dt);
   return {solver.particles(), solver.energies(), solver.active_nodes(), g.num_nodes()};
@@ -78,7 +78,7 @@ TEST_CASE("between steps every nodal value outside the active blocks is zero, on
   const Grid<2> g = grid(6.1, 0.7, 0.1);
   Particles<2> p = block(g, Vec<2>(0.3, 0.0), Vec<2>(2.3, 0.5), 1000, 2);
   for (auto& v : p.v) v = Vec<2>(-1.0, 0.2);
-  Settings s;
+  Settings<2> s;
   s.scheme = scheme;
   s.shape = shape;
   s.gravity = {0, -9.81};
@@ -86,7 +86,7 @@ TEST_CASE("between steps every nodal value outside the active blocks is zero, on
   s.walls = {Wall{left, 0.3}, Wall{Wall::Type::roller}, Wall{Wall::Type::fixed}, Wall{Wall::Type::roller}};
   s.obstacles.push_back({Vec<2>(4.0, 0.0), Vec<2>(4.5, 0.2), Wall{Wall::Type::friction, 0.4}, false});
   s.platens.push_back({Vec<2>(0.0, 0.5), Vec<2>(1.0, 0.6), 1, -1e3, std::nullopt});
-  Solver solver(g, elastic({1000, 1e7, 0.3}), std::move(p), s);
+  Solver<2> solver(g, elastic({1000, 1e7, 0.3}), std::move(p), s);
   for (int k = 0; k < 200; ++k) {
     solver.step(solver.stable_time_step());
     INFO("step " << k + 1);

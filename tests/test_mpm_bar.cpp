@@ -38,15 +38,15 @@ double bar_error(ShapeKind shape, Scheme scheme, int cells_along_bar) {
       particles.add(x, Vec<2>(v0 * std::sin(beta * x.x()), 0), rho * volume, volume, 0.5 / ppc, Mat<2>::Zero(), 0,
                     0);
     }
-  std::vector<std::unique_ptr<Material>> materials;
-  materials.push_back(std::make_unique<LinearElastic>("bar", Elasticity{rho, E, 0.0}));
-  Settings settings;
+  std::vector<std::unique_ptr<Material<2>>> materials;
+  materials.push_back(std::make_unique<LinearElastic<2>>("bar", Elasticity{rho, E, 0.0}));
+  Settings<2> settings;
   settings.shape = shape;
   settings.scheme = scheme;
   settings.flip_fraction = 1.0;
   settings.walls[0] = {Wall::Type::fixed, 0};
   settings.walls[2] = settings.walls[3] = {Wall::Type::roller, 0};
-  Solver solver(grid, std::move(materials), std::move(particles), settings);
+  Solver<2> solver(grid, std::move(materials), std::move(particles), settings);
 
   // One small step for every grid, so the error measured is the spatial one.
   const double period = 2 * pi / omega;

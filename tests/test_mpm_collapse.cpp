@@ -14,9 +14,9 @@ TEST_CASE("the granular column collapses to Lube's run-out and comes to rest", "
                                    {"mpm.grid.cell_size=\"0.05 m\""});
   auto root = doc->root();
   const auto header = read_scene_header(root);
-  auto setup = mpm::read_setup(*root.table("mpm", "", true));
+  auto setup = mpm::read_setup<2>(*root.table("mpm", "", true));
   doc->reject_unused();
-  mpm::Solver solver(setup.grid, std::move(setup.materials), std::move(setup.particles), setup.settings);
+  mpm::Solver<2> solver(setup.grid, std::move(setup.materials), std::move(setup.particles), setup.settings);
   double l0 = 0, h0 = 0;
   for (const auto& x : solver.particles().x) {
     l0 = std::max(l0, x.x());

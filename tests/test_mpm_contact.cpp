@@ -15,10 +15,10 @@ TEST_CASE("a block slides down a frictional slope at g (sin t - mu cos t)", "[mp
   // The slope is the floor, with gravity tilted by theta.
   const double theta = 30 * 3.14159265358979323846 / 180, mu = 0.2, g = 9.81;
   const Grid<2> gr = grid(8.0, 2.0, 0.1);
-  Settings s;
+  Settings<2> s;
   s.gravity = {g * std::sin(theta), -g * std::cos(theta)};
   s.walls[2] = {Wall::Type::friction, mu};
-  Solver solver(gr, elastic({1000, 5e7, 0.3}), block(gr, {0.5, 0}, {1.5, 0.5}, 1000, 2), s);
+  Solver<2> solver(gr, elastic({1000, 5e7, 0.3}), block(gr, {0.5, 0}, {1.5, 0.5}, 1000, 2), s);
   const double t_end = 0.8;
   while (solver.time() < t_end) solver.step(std::min(solver.stable_time_step(), t_end - solver.time()));
   const auto& p = solver.particles();
@@ -41,12 +41,12 @@ TEST_CASE("a block slides down a rigid frictional obstacle at g (sin t - mu cos 
   const double theta = 30 * 3.14159265358979323846 / 180, mu = 0.2, g = 9.81, h = 0.1;
   const double surface = GENERATE(0.5, 0.545);
   const Grid<2> gr = grid(8.0, 2.0, h);
-  Settings s;
+  Settings<2> s;
   s.gravity = {g * std::sin(theta), -g * std::cos(theta)};
   s.obstacles.push_back({{0, 0}, {8.0, surface}, {Wall::Type::friction, mu}});
   // The particles fill the cells above the surface.
   const double base = std::ceil(surface / h - 1e-9) * h;
-  Solver solver(gr, elastic({1000, 5e7, 0.3}), block(gr, {0.5, base}, {1.5, base + 0.5}, 1000, 2), s);
+  Solver<2> solver(gr, elastic({1000, 5e7, 0.3}), block(gr, {0.5, base}, {1.5, base + 0.5}, 1000, 2), s);
   const double t_end = 0.8;
   const Energies start = solver.energies();
   double lowest = 1e9;
@@ -90,12 +90,12 @@ TEST_CASE("a block dropped on an obstacle comes to rest on it, no matter its cor
   // kernel's reach of the face (1.5 cells for B-splines), never below it.
   const double g = 9.81, h = 0.1;
   const Grid<2> gr = grid(4.0, 4.0, h);
-  Settings s;
+  Settings<2> s;
   s.gravity = {0, -g};
   s.local_damping = 0.5;
   s.walls[2] = {Wall::Type::fixed};
   s.obstacles.push_back({{1.8, 0}, {2.2, 1.0}, {Wall::Type::friction, 0.5}});
-  Solver solver(gr, elastic({1000, 2e7, 0.3}), block(gr, {1.5, 1.5}, {2.5, 2.0}, 1000, 2), s);
+  Solver<2> solver(gr, elastic({1000, 2e7, 0.3}), block(gr, {1.5, 1.5}, {2.5, 2.0}, 1000, 2), s);
   while (solver.time() < 1.5) solver.step(solver.stable_time_step());
   double lowest_over_pillar = 1e9, mean_x = 0;
   const auto& p = solver.particles();
@@ -138,7 +138,7 @@ box_max = ["1 m", "1 m"]
                                     "overlap.toml");
   auto root = doc->root();
   read_scene_header(root);
-  CHECK_THROWS_WITH(read_setup(*root.table("mpm", "", true)),
+  CHECK_THROWS_WITH(read_setup<2>(*root.table("mpm", "", true)),
                     Catch::Contains("overlap.toml") && Catch::Contains("mpm.bodies[0].box_min") &&
                         Catch::Contains("overlaps obstacle 1"));
 }
@@ -150,11 +150,11 @@ TEST_CASE("a settling stage brings a block to rest against its support, and the 
   // support is gone the block must slide freely: x = -g t^2 / 2 from rest.
   const double g = 9.81, h = 0.1;
   const Grid<2> gr = grid(4.0, 1.0, h);
-  Settings s;
+  Settings<2> s;
   s.gravity = {-g, 0};
   s.walls[2] = Wall{Wall::Type::roller};
   s.obstacles.push_back({{1.0, 0.0}, {1.5, 1.0}, {Wall::Type::roller}, true});
-  Solver solver(gr, elastic({1000, 5e7, 0.3}), block(gr, {1.5, 0}, {2.5, 0.5}, 1000, 2), s);
+  Solver<2> solver(gr, elastic({1000, 5e7, 0.3}), block(gr, {1.5, 0}, {2.5, 0.5}, 1000, 2), s);
   solver.settle({0.3, 0.8}, std::nullopt);
   // Equilibrium: the support carries the block's weight, sigma_xx growing
   // linearly from the free end, -rho g L / 2 on average.
@@ -204,7 +204,7 @@ box_max = ["2 m", "1 m"]
                                     "support.toml");
   auto root = doc->root();
   read_scene_header(root);
-  CHECK_THROWS_WITH(read_setup(*root.table("mpm", "", true)),
+  CHECK_THROWS_WITH(read_setup<2>(*root.table("mpm", "", true)),
                     Catch::Contains("support.toml") && Catch::Contains("obstacles[0].support") &&
                         Catch::Contains("[mpm.settle]"));
 }
@@ -217,7 +217,7 @@ TEST_CASE("a rigid platen presses two columns side by side to one settlement, lo
   // (a traction would load both alike).
   const double force = 1e4, e1 = 2e7, e2 = 1e7, b = 1.0;
   const Grid<2> gr = grid(1.5, 1.5, 0.05);
-  Settings s;
+  Settings<2> s;
   s.viscous_damping = 600;
   // The sudden load rings grid-scale modes whose damping the books overstate
   // by O(omega dt) (30 % of the load's work at Courant 0.3, 0.6 % at 0.05).
@@ -226,10 +226,10 @@ TEST_CASE("a rigid platen presses two columns side by side to one settlement, lo
   s.platens.push_back({Vec<2>(-1, b), Vec<2>(2, 2), 1, -force, std::nullopt});
   auto particles = block(gr, {0, 0}, {1, b}, 1000, 2);
   for (std::size_t i = 0; i < particles.size(); ++i) particles.material[i] = particles.x[i].x() < 0.5 ? 0 : 1;
-  std::vector<std::unique_ptr<Material>> materials;
-  materials.push_back(std::make_unique<LinearElastic>("stiff", Elasticity{1000, e1, 0}));
-  materials.push_back(std::make_unique<LinearElastic>("soft", Elasticity{1000, e2, 0}));
-  Solver solver(gr, std::move(materials), std::move(particles), s);
+  std::vector<std::unique_ptr<Material<2>>> materials;
+  materials.push_back(std::make_unique<LinearElastic<2>>("stiff", Elasticity{1000, e1, 0}));
+  materials.push_back(std::make_unique<LinearElastic<2>>("soft", Elasticity{1000, e2, 0}));
+  Solver<2> solver(gr, std::move(materials), std::move(particles), s);
   while (solver.time() < 0.1) solver.step(std::min(solver.stable_time_step(), 0.1 - solver.time()));
   const auto& p = solver.particles();
   double stiff = 0, soft = 0, top = 0;

@@ -20,7 +20,7 @@ TEST_CASE("two elastic disks collide with the energy balanced", "[mpm][disks]") 
   const double radius = 0.2, v0 = 0.1, rho = 1000;
   std::vector<Vec<2>> points;
   for (const Vec<2>& centre : {Vec<2>(0.25, 0.25), Vec<2>(0.75, 0.75)})
-    fill_cells(gr, 2, centre.array() - radius, centre.array() + radius,
+    fill_cells<2>(gr, 2, centre.array() - radius, centre.array() + radius,
                [&](const Vec<2>& x) { return (x - centre).norm() <= radius; }, points);
   Particles<2> p;
   const double volume = (gr.h / 2) * (gr.h / 2);
@@ -28,10 +28,10 @@ TEST_CASE("two elastic disks collide with the energy balanced", "[mpm][disks]") 
     const Vec<2> v = x.x() < 0.5 ? Vec<2>(v0, v0) : Vec<2>(-v0, -v0);
     p.add(x, v, rho * volume, volume, 0.25, Mat<2>::Zero(), 0, 0);
   }
-  Settings s;
+  Settings<2> s;
   s.shape = GENERATE(ShapeKind::gimp, ShapeKind::bspline);
   s.flip_fraction = 1.0;
-  Solver solver(gr, elastic({rho, 1000, 0.3}), std::move(p), s);
+  Solver<2> solver(gr, elastic({rho, 1000, 0.3}), std::move(p), s);
   const double e0 = solver.energies().total();
   double worst = 0, least_kinetic = e0;
   while (solver.time() < 3.0) {

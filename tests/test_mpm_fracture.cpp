@@ -106,8 +106,8 @@ double cohesive_force(double u) {
 
 // The bar's grid and boundaries: [0, length] x [0, height] on rollers at
 // x = 0 and y = 0 (a symmetric half), pulled at x = length by a plate.
-Settings bar_settings(double h, ShapeKind shape) {
-  Settings s;
+Settings<2> bar_settings(double h, ShapeKind shape) {
+  Settings<2> s;
   s.shape = shape;
   s.walls = {Wall{Wall::Type::roller}, Wall{}, Wall{Wall::Type::roller}, Wall{}};
   s.platens.push_back({Vec<2>(length - 0.25 * h, -1), Vec<2>(length + 3 * h, 1), 0, 0, speed});
@@ -115,9 +115,9 @@ Settings bar_settings(double h, ShapeKind shape) {
 }
 
 // Pulls the bar until the plate has moved `to`; the crack is `ligament` high.
-Pull pull_until(double h, const Settings& s, std::vector<std::unique_ptr<Material>> materials,
+Pull pull_until(double h, const Settings<2>& s, std::vector<std::unique_ptr<Material<2>>> materials,
                 Particles<2> particles, double to, double ligament) {
-  Solver solver(grid(length + 3 * h, height, h), std::move(materials), std::move(particles), s);
+  Solver<2> solver(grid(length + 3 * h, height, h), std::move(materials), std::move(particles), s);
   Pull r;
   Curve curve(to);
   while (solver.platen_displacement()[0] < to) {
@@ -141,14 +141,14 @@ Pull pull(double h, ShapeKind shape, bool local) {
     // Already stretching as the plate will stretch it: no wave at the start.
     particles.v[i].x() = speed * x / length;
   }
-  std::vector<std::unique_ptr<Material>> materials;
+  std::vector<std::unique_ptr<Material<2>>> materials;
   for (double share : {1.0, weak, grip}) {
     DamageParameters d{1e6, 0.5, share * strength, 0.3, 5.0, std::nullopt};
     if (!local) {
       d.fracture_energy = fracture_energy;
       d.band_width = crack_cells(shape) * h;
     }
-    materials.push_back(std::make_unique<ElasticDamage>("coal", coal, d));
+    materials.push_back(std::make_unique<ElasticDamage<2>>("coal", coal, d));
   }
   return pull_until(h, bar_settings(h, shape), std::move(materials), std::move(particles), end, height);
 }
@@ -221,7 +221,7 @@ struct Bend {
 
 Bend bend(double h, bool local) {
   const Grid<2> gr = grid(overall, depth + 2 * width, h);
-  Settings s;
+  Settings<2> s;
   s.shape = ShapeKind::linear;
   s.courant = 0.5;
   for (double x : {centre - 0.5 * span, centre + 0.5 * span})
@@ -237,15 +237,15 @@ Bend bend(double h, bool local) {
     const double shape = (3 * span * span * from_support - 4 * std::pow(from_support, 3)) / std::pow(span, 3);
     particles.add(x, Vec<2>(0, -press * shape), all.mass[i], all.volume[i], all.half_width[i], Mat<2>::Zero(), 0, 0);
   }
-  std::vector<std::unique_ptr<Material>> materials;
+  std::vector<std::unique_ptr<Material<2>>> materials;
   // Strong in shear and compression, so that nothing breaks under the plates.
   DamageParameters d{10e6, 0.5, strength, 0.3, 5.0, std::nullopt};
   if (!local) {
     d.fracture_energy = fracture_energy;
     d.band_width = crack_cells(s.shape) * h;
   }
-  materials.push_back(std::make_unique<ElasticDamage>("coal", coal, d));
-  Solver solver(gr, std::move(materials), std::move(particles), s);
+  materials.push_back(std::make_unique<ElasticDamage<2>>("coal", coal, d));
+  Solver<2> solver(gr, std::move(materials), std::move(particles), s);
   Curve curve(deflection);
   while (-solver.platen_displacement()[2] < deflection) {
     solver.step(solver.stable_time_step());
@@ -315,8 +315,8 @@ Pull pull_nonlocal(double h) {
   }
   DamageParameters d{1e6, 0.5, strength, 0.3, eta, std::nullopt};
   d.internal_length = radius;
-  std::vector<std::unique_ptr<Material>> materials;
-  materials.push_back(std::make_unique<ElasticDamage>("coal", coal, d));
+  std::vector<std::unique_ptr<Material<2>>> materials;
+  materials.push_back(std::make_unique<ElasticDamage<2>>("coal", coal, d));
   return pull_until(h, bar_settings(h, ShapeKind::linear), std::move(materials), std::move(particles), nonlocal_end,
                     height - neck_depth);
 }

@@ -15,12 +15,12 @@ TEST_CASE("a column under gravity settles to sigma_yy = -rho g (H - y) and K0 la
           "[mpm][gravity]") {
   const double H = 10, rho = 1000, g = 9.81, nu = 0.25;
   const Grid<2> gr = grid(1.0, 12.0, 0.25);
-  Settings s;
+  Settings<2> s;
   s.shape = GENERATE(ShapeKind::gimp, ShapeKind::linear, ShapeKind::bspline);
   s.gravity = {0, -g};
   s.local_damping = 0.7;  // quasi-static: settle, then compare with the static answer
   s.walls = {Wall{Wall::Type::roller}, Wall{Wall::Type::roller}, Wall{Wall::Type::fixed}, Wall{}};
-  Solver solver(gr, elastic({rho, 1e8, nu}), block(gr, {0, 0}, {1, H}, rho, 2), s);
+  Solver<2> solver(gr, elastic({rho, 1e8, nu}), block(gr, {0, 0}, {1, H}, rho, 2), s);
   for (int i = 0; i < 6000; ++i) solver.step(solver.stable_time_step());
   const auto& p = solver.particles();
   double sum = 0, worst_ratio = 0;
@@ -50,13 +50,13 @@ TEST_CASE("nodal dilatation smoothing removes the pressure checkerboard of a nea
   double rms[2];
   for (int remedy = 0; remedy < 2; ++remedy) {
     const Grid<2> gr = grid(1.0, 5.0, 0.125);
-    Settings s;
+    Settings<2> s;
     s.shape = ShapeKind::gimp;
     s.gravity = {0, -g};
     s.local_damping = 0.7;
     s.smooth_dilatation = remedy == 1;
     s.walls = {Wall{Wall::Type::roller}, Wall{Wall::Type::roller}, Wall{Wall::Type::fixed}, Wall{}};
-    Solver solver(gr, elastic({rho, 1e8, nu}), block(gr, {0, 0}, {1, H}, rho, 2), s);
+    Solver<2> solver(gr, elastic({rho, 1e8, nu}), block(gr, {0, 0}, {1, H}, rho, 2), s);
     for (int i = 0; i < 6000; ++i) solver.step(solver.stable_time_step());
     const auto& p = solver.particles();
     double sum = 0;
@@ -78,10 +78,10 @@ TEST_CASE("nodal dilatation smoothing removes the pressure checkerboard of a nea
 
 TEST_CASE("a step far beyond the stable one stops the run naming step, particle and field", "[mpm][robust]") {
   const Grid<2> gr = grid(4.0, 4.0, 0.25);
-  Settings s;
+  Settings<2> s;
   s.gravity = {0, -9.81};
   s.walls[2] = {Wall::Type::fixed};
-  Solver solver(gr, elastic({1000, 1e7, 0.3}), block(gr, {1, 0}, {3, 2}, 1000, 2), s);
+  Solver<2> solver(gr, elastic({1000, 1e7, 0.3}), block(gr, {1, 0}, {3, 2}, 1000, 2), s);
   const double dt = 5 * solver.stable_time_step() / s.courant;  // five times the CFL limit
   try {
     for (int i = 0; i < 1000; ++i) solver.step(dt);

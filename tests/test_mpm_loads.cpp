@@ -45,10 +45,10 @@ traction = ["0 Pa", "-1.5 MPa"]
                                     "traction.toml");
   auto root = doc->root();
   read_scene_header(root);
-  auto setup = read_setup(*root.table("mpm", "", true));
+  auto setup = read_setup<2>(*root.table("mpm", "", true));
   doc->reject_unused();
   REQUIRE(setup.tracers.size() == 1);
-  Solver solver(setup.grid, std::move(setup.materials), std::move(setup.particles), setup.settings);
+  Solver<2> solver(setup.grid, std::move(setup.materials), std::move(setup.particles), setup.settings);
   for (int i = 0; i < 3000; ++i) solver.step(solver.stable_time_step());
   // The load acts on the top particles and spreads through the top cell: the
   // particles in that cell carry part of it; below, the stress is uniform.
@@ -63,11 +63,11 @@ traction = ["0 Pa", "-1.5 MPa"]
 TEST_CASE("viscous damping slows a drifting block as exp(-c t) and books what it takes", "[mpm][damping]") {
   const double c = 5.0, v0 = 2.0, t_end = 0.2;
   const Grid<2> gr = grid(4.0, 2.0, 0.1);
-  Settings s;
+  Settings<2> s;
   s.viscous_damping = c;
   auto particles = block(gr, {1.0, 0.5}, {1.5, 1.0}, 1000, 2);
   for (auto& v : particles.v) v = Vec<2>(v0, 0);
-  Solver solver(gr, elastic({1000, 5e7, 0.3}), std::move(particles), s);
+  Solver<2> solver(gr, elastic({1000, 5e7, 0.3}), std::move(particles), s);
   const double start = solver.energies().total();
   while (solver.time() < t_end) solver.step(std::min(solver.stable_time_step(), t_end - solver.time()));
   const auto& p = solver.particles();

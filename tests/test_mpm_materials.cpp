@@ -29,7 +29,7 @@ Particles<2> one_particle() {
 }
 
 // Drive the particle with a constant velocity gradient for `steps` of dt.
-void drive(const Material& m, Particles<2>& p, const Mat<2>& l, int steps, double dt) {
+void drive(const Material<2>& m, Particles<2>& p, const Mat<2>& l, int steps, double dt) {
   p.velocity_gradient[0] = l;
   for (int s = 0; s < steps; ++s) m.update_stress(p, {0}, dt);
 }
@@ -48,7 +48,7 @@ TEST_CASE("Drucker-Prager coefficients match the paper's outer-cone fit", "[mpm]
 }
 
 TEST_CASE("elastic Jaumann rate: uniaxial strain and a rigid rotation", "[mpm][material]") {
-  LinearElastic m("coal", coal);
+  LinearElastic<2> m("coal", coal);
   auto p = one_particle();
   Mat<2> l = Mat<2>::Zero();
   l(0, 0) = -1e-3;  // compress along x at 1e-3 /s for 1 s
@@ -73,7 +73,7 @@ TEST_CASE("Drucker-Prager compression with shear stays on the cone as computed b
   // shear grows until the cone is reached. With no dilation, plastic flow keeps
   // the volume, so the mean stress is K times the total volumetric strain, and
   // on the cone sqrt(J2) = k - alpha * mean.
-  DruckerPrager m("coal", coal, 1e6, 30 * deg, 0.0, DruckerPragerFit::Kind::outer);
+  DruckerPrager<2> m("coal", coal, 1e6, 30 * deg, 0.0, DruckerPragerFit::Kind::outer);
   auto p = one_particle();
   Mat<2> l = Mat<2>::Zero();
   l(0, 0) = -1.0;
@@ -91,7 +91,7 @@ TEST_CASE("Drucker-Prager compression with shear stays on the cone as computed b
 }
 
 TEST_CASE("Drucker-Prager tension returns to the apex: hydrostatic k / alpha", "[mpm][material]") {
-  DruckerPrager m("coal", coal, 1e6, 30 * deg, 0.0, DruckerPragerFit::Kind::outer);
+  DruckerPrager<2> m("coal", coal, 1e6, 30 * deg, 0.0, DruckerPragerFit::Kind::outer);
   auto p = one_particle();
   Mat<2> l = Mat<2>::Zero();
   l(0, 0) = 1.0;
@@ -104,8 +104,8 @@ TEST_CASE("Drucker-Prager tension returns to the apex: hydrostatic k / alpha", "
 }
 
 TEST_CASE("Drucker-Prager below the yield surface is elastic", "[mpm][material]") {
-  DruckerPrager plastic("coal", coal, 1e6, 30 * deg, 0.0, DruckerPragerFit::Kind::outer);
-  LinearElastic elastic("coal", coal);
+  DruckerPrager<2> plastic("coal", coal, 1e6, 30 * deg, 0.0, DruckerPragerFit::Kind::outer);
+  LinearElastic<2> elastic("coal", coal);
   auto a = one_particle(), b = one_particle();
   Mat<2> l = Mat<2>::Zero();
   l(0, 0) = -1e-5;
@@ -123,7 +123,7 @@ const DamageParameters coal_damage{1e6, 30 * deg, 0.2e6, 0.1, 5.0, std::nullopt}
 }  // namespace
 
 TEST_CASE("elastic-damage: uniaxial-strain tension follows D = 1 - f_tr / (E0 eps)", "[mpm][material][damage]") {
-  ElasticDamage m("coal", coal, coal_damage);
+  ElasticDamage<2> m("coal", coal, coal_damage);
   auto p = one_particle();
   Mat<2> l = Mat<2>::Zero();
   l(0, 0) = 1.0;
@@ -138,7 +138,7 @@ TEST_CASE("elastic-damage: uniaxial-strain tension follows D = 1 - f_tr / (E0 ep
 }
 
 TEST_CASE("elastic-damage: broken coal carries no tension but carries compression", "[mpm][material][damage]") {
-  ElasticDamage m("coal", coal, coal_damage);
+  ElasticDamage<2> m("coal", coal, coal_damage);
   auto p = one_particle();
   Mat<2> l = Mat<2>::Zero();
   l(0, 0) = 1.0;
@@ -156,7 +156,7 @@ TEST_CASE("elastic-damage: broken coal carries no tension but carries compressio
 }
 
 TEST_CASE("elastic-damage: damage never heals on unloading", "[mpm][material][damage]") {
-  ElasticDamage m("coal", coal, coal_damage);
+  ElasticDamage<2> m("coal", coal, coal_damage);
   auto p = one_particle();
   Mat<2> l = Mat<2>::Zero();
   l(0, 0) = 1.0;
@@ -169,7 +169,7 @@ TEST_CASE("elastic-damage: damage never heals on unloading", "[mpm][material][da
 }
 
 TEST_CASE("elastic-damage: shear damage weakens toward the friction cone", "[mpm][material][damage]") {
-  ElasticDamage m("coal", coal, coal_damage);
+  ElasticDamage<2> m("coal", coal, coal_damage);
   auto p = one_particle();
   Mat<2> l = Mat<2>::Zero();
   l(0, 0) = -1.0;
@@ -177,7 +177,7 @@ TEST_CASE("elastic-damage: shear damage weakens toward the friction cone", "[mpm
   drive(m, p, l, 2000, 2e-3 / 2000);
   CHECK(p.damage[0] > 0.5);
   // The stress acting lies inside the cone of the remaining cohesion.
-  DruckerPrager remaining("left", coal, (1 - p.damage[0]) * 1e6, 30 * deg, 0.0, DruckerPragerFit::Kind::outer);
+  DruckerPrager<2> remaining("left", coal, (1 - p.damage[0]) * 1e6, 30 * deg, 0.0, DruckerPragerFit::Kind::outer);
   CHECK(remaining.yield(p.stress[0], p.stress_zz[0]) <= 1e-6 * 1e6);
   CHECK(p.plastic_strain[0] > 0);
 }
@@ -187,7 +187,7 @@ TEST_CASE("elastic-damage: the work done equals the energy stored plus the energ
   // Pull in uniaxial strain through damage to full damage, then shear and
   // compress the fragments: at every step the stress power integrated so far
   // must match the stored energy plus the damage and plastic dissipation.
-  ElasticDamage m("coal", coal, coal_damage);
+  ElasticDamage<2> m("coal", coal, coal_damage);
   auto p = one_particle();
   const std::vector<int> members{0};
   const auto power = [&](const Mat<2>& l) { return p.volume[0] * p.stress[0].cwiseProduct(l).sum(); };
@@ -220,7 +220,7 @@ TEST_CASE("elastic-damage: the work done equals the energy stored plus the energ
 }
 
 TEST_CASE("elastic-damage: broken coal bulks to its bulking factor and no further", "[mpm][material][damage]") {
-  ElasticDamage m("coal", coal, coal_damage);
+  ElasticDamage<2> m("coal", coal, coal_damage);
   auto p = one_particle();
   Mat<2> l = Mat<2>::Zero();
   l(0, 0) = 1.0;
@@ -294,7 +294,7 @@ TEST_CASE("heterogeneous coal: a particle's damage starts at its own share of th
           "particles are drawn", "[mpm][material][damage][heterogeneity]") {
   DamageParameters d = coal_damage;
   d.heterogeneity = DamageParameters::Heterogeneity{3.0, 11};
-  ElasticDamage m("coal", coal, d);
+  ElasticDamage<2> m("coal", coal, d);
   // Uniaxial tension at 0.6 f_t: intact at a factor of 1, damaged at 0.5.
   Mat<2> s = Mat<2>::Zero();
   s(0, 0) = 0.6 * d.tensile_strength;
@@ -319,7 +319,7 @@ TEST_CASE("heterogeneous coal with a grain size: particles share their grain's d
           "[mpm][material][damage][heterogeneity]") {
   DamageParameters d = coal_damage;
   d.heterogeneity = DamageParameters::Heterogeneity{3.0, 5, std::nullopt, 0.25};
-  ElasticDamage m("coal", coal, d);
+  ElasticDamage<2> m("coal", coal, d);
   // Two fills of the same 2 m x 1 m block, below and right of the origin,
   // at spacings of 1/12 and 1/16 m (1/6 and 1/8 m cells, 4 per cell): the
   // factors at a point are its grain's, whichever fill it is in.
@@ -360,8 +360,8 @@ TEST_CASE("heterogeneous coal: a particle's modulus factor sets its wave speed, 
           "[mpm][material][damage][heterogeneity]") {
   DamageParameters d = coal_damage;
   d.heterogeneity = DamageParameters::Heterogeneity{1.5, 3};
-  std::vector<std::unique_ptr<Material>> materials;
-  materials.push_back(std::make_unique<ElasticDamage>("coal", coal, d));
+  std::vector<std::unique_ptr<Material<2>>> materials;
+  materials.push_back(std::make_unique<ElasticDamage<2>>("coal", coal, d));
   Particles<2> p;
   for (int k = 0; k < 4000; ++k) p.add({0, 0}, {0, 0}, coal.density, 1, 0.5, Mat<2>::Zero(), 0, 0);
   std::vector<int> all(p.size());
@@ -392,7 +392,7 @@ TEST_CASE("heterogeneous coal: a particle s_E times as stiff, strained 1 / s_E a
           "damage and friction, with 1 / s_E the plastic strain and work", "[mpm][material][damage][heterogeneity]") {
   DamageParameters d = coal_damage;
   d.heterogeneity = DamageParameters::Heterogeneity{3.0, 1};
-  const ElasticDamage m("coal", coal, d);
+  const ElasticDamage<2> m("coal", coal, d);
   // Pure shear under a little compression (no spin: the Jaumann rotation goes
   // with the strain, not the moduli): into the friction cone and past the
   // shear damage's onset.
@@ -429,14 +429,14 @@ TEST_CASE("crack band: a material point dissipates G_f per band width whatever h
   // share of the energy is large, and (lambda + 2G) / E = 2.14.
   DamageParameters d{1e6, 30 * deg, 0.2e6, 0.1, 5.0, 2.4};
   d.band_width = 0.9 * largest_band_width(d, coal);
-  const ElasticDamage uniform("coal", coal, d);
+  const ElasticDamage<2> uniform("coal", coal, d);
   d.heterogeneity = DamageParameters::Heterogeneity{3.0, 1};
-  const ElasticDamage drawn("coal", coal, d);
+  const ElasticDamage<2> drawn("coal", coal, d);
   // A weak, soft particle and a strong, stiff one: each keeps its
   // characteristic length, so the band stays within its snap-back limit.
   const auto [strength, stiffness] = GENERATE(std::pair{1.0, 1.0}, std::pair{0.6, 0.5}, std::pair{1.7, 2.2});
   const bool heterogeneous = strength != 1.0;
-  const Material& m = heterogeneous ? static_cast<const Material&>(drawn) : uniform;
+  const Material<2>& m = heterogeneous ? static_cast<const Material<2>&>(drawn) : uniform;
   const double per_volume = strength * strength / stiffness * *d.fracture_energy / d.band_width;
   // Stretched along x with y held (uniaxial strain: the intact coal holds a
   // crack's sides) and with y free (uniaxial stress in the plane: the bar).

@@ -28,11 +28,11 @@ double mms_error(ShapeKind shape, int cells) {
   Grid<2> gr = grid(1.0, h, h);
   Particles<2> p = block(gr, {0, 0}, {1, h}, rho, 2);
   for (std::size_t i = 0; i < p.size(); ++i) p.v[i] = Vec<2>(A * pi * std::sin(2 * pi * p.x[i].x()), 0);
-  Settings s;
+  Settings<2> s;
   s.shape = shape;
   s.flip_fraction = 1.0;
   s.walls = {Wall{Wall::Type::fixed}, Wall{Wall::Type::fixed}, Wall{Wall::Type::roller}, Wall{Wall::Type::roller}};
-  Solver solver(gr, elastic({rho, E, 0.0}), std::move(p), s);
+  Solver<2> solver(gr, elastic({rho, E, 0.0}), std::move(p), s);
   const int steps = 4 * 2560;
   const double dt = 1.0 / steps;
   double worst = 0;

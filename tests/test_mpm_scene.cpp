@@ -18,7 +18,7 @@ void read_mpm_scene(const std::string& text) {
   auto root = doc->root();
   const auto header = read_scene_header(root);
   const auto mpm_table = root.table("mpm", "", true);
-  const auto setup = mpm::read_setup(*mpm_table);
+  const auto setup = mpm::read_setup<2>(*mpm_table);
   doc->reject_unused();
   mpm::check_run_length(*mpm_table, setup, header.end_time);
 }

@@ -12,7 +12,7 @@ using namespace outburst::testing;
 
 namespace {
 
-double fresh(const Solver& s) {
+double fresh(const Solver<2>& s) {
   return stable_time_step(s.materials(), s.particles(), s.grid().h, s.settings().courant);
 }
 
@@ -28,12 +28,12 @@ TEST_CASE("the stable step from the move's census equals a fresh pass over the p
   const Grid<2> g = grid(2.0, 1.0, 0.1);
   Particles<2> p = block(g, Vec<2>(1.2, 0.0), Vec<2>(1.9, 0.6), 1000, 2);
   for (std::size_t i = 0; i < p.size(); ++i) p.v[i] = Vec<2>(30.0 + 20.0 * p.x[i].x(), -5.0 * p.x[i].y());
-  Settings s;
+  Settings<2> s;
   s.scheme = scheme;
   s.apic = apic;
   s.gravity = {0, -9.81};
   s.walls = {Wall{Wall::Type::roller}, Wall{}, Wall{Wall::Type::fixed}, Wall{}};
-  Solver solver(g, elastic({1000, 1e8, 0.3}), std::move(p), s);  // P waves of 400 m/s
+  Solver<2> solver(g, elastic({1000, 1e8, 0.3}), std::move(p), s);  // P waves of 400 m/s
   const std::size_t start = solver.particles().size();
   std::size_t removed_while_checked = 0;
   for (int k = 0; k < 200 && solver.particles().size() > start / 4; ++k) {

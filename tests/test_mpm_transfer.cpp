@@ -20,7 +20,7 @@ double spin_kept(ShapeKind shape, bool apic, double flip, int steps) {
   const Vec<2> centre(0.5, 0.5);
   const double omega = 1.0, radius = 0.3;
   std::vector<Vec<2>> points;
-  fill_cells(gr, 2, centre.array() - radius, centre.array() + radius,
+  fill_cells<2>(gr, 2, centre.array() - radius, centre.array() + radius,
              [&](const Vec<2>& x) { return (x - centre).norm() <= radius; }, points);
   Particles<2> p;
   const double volume = 0.025 * 0.025;
@@ -29,11 +29,11 @@ double spin_kept(ShapeKind shape, bool apic, double flip, int steps) {
     p.add(x, omega * Vec<2>(-r.y(), r.x()), 1000 * volume, volume, 0.25, Mat<2>::Zero(), 0, 0);
     if (apic) p.affine.back() << 0, -omega, omega, 0;  // the rigid rotation's velocity gradient
   }
-  Settings s;
+  Settings<2> s;
   s.shape = shape;
   s.apic = apic;
   s.flip_fraction = flip;
-  Solver solver(gr, elastic({1000, 1e6, 0.3}), std::move(p), s);
+  Solver<2> solver(gr, elastic({1000, 1e6, 0.3}), std::move(p), s);
   const auto angular = [&] {
     double l = 0;
     const auto& q = solver.particles();

@@ -28,7 +28,7 @@ TEST_CASE("shipped scenes are valid", "[scene][cases]") {
     const bool coupled = header.solvers.size() == 2;
     for (const auto& solver : header.solvers) {
       if (solver == "seepage") REQUIRE_NOTHROW(seepage::read_setup(*root.table("seepage", "", true), !coupled));
-      if (solver == "mpm") REQUIRE_NOTHROW(mpm::read_setup(*root.table("mpm", "", true)));
+      if (solver == "mpm") REQUIRE_NOTHROW(mpm::read_setup<2>(*root.table("mpm", "", true)));
     }
     if (coupled) REQUIRE_NOTHROW(coupling::read_coupling(*root.table("coupling", "", true)));
     REQUIRE_NOTHROW(doc->reject_unused());

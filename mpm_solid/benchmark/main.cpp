@@ -53,7 +53,7 @@ double unloaded_particle_steps_per_second(long particles) {
   g.upper = {g.cells[0] * g.h, g.cells[1] * g.h};
   std::vector<Vec<2>> points;
   const Vec<2> centre(side, side);
-  fill_cells(g, per_cell, centre.array() - side / 2.0, centre.array() + side / 2.0,
+  fill_cells<2>(g, per_cell, centre.array() - side / 2.0, centre.array() + side / 2.0,
              [](const Vec<2>&) { return true; }, points);
   Particles<2> p;
   const double volume = 1.0 / (per_cell * per_cell);
@@ -61,9 +61,9 @@ double unloaded_particle_steps_per_second(long particles) {
     const Vec<2> r = x - centre;
     p.add(x, 0.01 * Vec<2>(-r.y(), r.x()), 1600 * volume, volume, 0.5 / per_cell, Mat<2>::Zero(), 0, 0);
   }
-  std::vector<std::unique_ptr<Material>> materials;
-  materials.push_back(std::make_unique<LinearElastic>("coal", Elasticity{1600, 6e7, 0.3}));
-  Solver solver(g, std::move(materials), std::move(p), Settings{});
+  std::vector<std::unique_ptr<Material<2>>> materials;
+  materials.push_back(std::make_unique<LinearElastic<2>>("coal", Elasticity{1600, 6e7, 0.3}));
+  Solver<2> solver(g, std::move(materials), std::move(p), Settings<2>{});
   const double dt = solver.stable_time_step();
   const long n = static_cast<long>(solver.particles().size());
   for (int i = 0; i < 3; ++i) solver.step(dt);
@@ -80,7 +80,7 @@ double unloaded_particle_steps_per_second(long particles) {
 
 struct Measured {
   double particle_steps_per_second;
-  Solver::Memory memory;
+  Solver<2>::Memory memory;
   long particles;
 };
 
@@ -95,27 +95,27 @@ Measured measure(long particles, ShapeKind shape, Model model, int threads) {
   g.cells = {side * 2, side + 4};
   g.upper = {g.cells[0] * h, g.cells[1] * h};
   std::vector<Vec<2>> points;
-  fill_cells(g, per_cell, Vec<2>(side / 2.0, 0), Vec<2>(side * 1.5, side), [](const Vec<2>&) { return true; }, points);
+  fill_cells<2>(g, per_cell, Vec<2>(side / 2.0, 0), Vec<2>(side * 1.5, side), [](const Vec<2>&) { return true; }, points);
   Particles<2> p;
   const double volume = (h / per_cell) * (h / per_cell);
   for (const auto& x : points) p.add(x, Vec<2>::Zero(), 1600 * volume, volume, 0.5 / per_cell, Mat<2>::Zero(), 0, 0);
   const Elasticity e{1600, 6e7, 0.3};
-  std::vector<std::unique_ptr<Material>> materials;
+  std::vector<std::unique_ptr<Material<2>>> materials;
   switch (model) {
-    case Model::elastic: materials.push_back(std::make_unique<LinearElastic>("coal", e)); break;
+    case Model::elastic: materials.push_back(std::make_unique<LinearElastic<2>>("coal", e)); break;
     case Model::drucker_prager:
-      materials.push_back(std::make_unique<DruckerPrager>("coal", e, 1e4, 0.5, 0.0, DruckerPragerFit::Kind::outer));
+      materials.push_back(std::make_unique<DruckerPrager<2>>("coal", e, 1e4, 0.5, 0.0, DruckerPragerFit::Kind::outer));
       break;
     case Model::elastic_damage:
       // Weak enough that the block damages as it lands.
-      materials.push_back(std::make_unique<ElasticDamage>("coal", e, DamageParameters{2e4, 0.5, 2e3, 0.1, 5, std::nullopt}));
+      materials.push_back(std::make_unique<ElasticDamage<2>>("coal", e, DamageParameters{2e4, 0.5, 2e3, 0.1, 5, std::nullopt}));
       break;
   }
-  Settings s;
+  Settings<2> s;
   s.shape = shape;
   s.gravity = {0, -9.81};
   s.walls = {Wall{Wall::Type::roller}, Wall{Wall::Type::roller}, Wall{Wall::Type::fixed}, Wall{}};
-  Solver solver(g, std::move(materials), std::move(p), s);
+  Solver<2> solver(g, std::move(materials), std::move(p), s);
   const double dt = solver.stable_time_step();
   const long n = static_cast<long>(solver.particles().size());
   const int warmup = 3;

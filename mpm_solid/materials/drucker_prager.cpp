@@ -5,42 +5,53 @@
 
 namespace outburst::mpm {
 
-DruckerPrager::DruckerPrager(std::string name, Elasticity elasticity, double cohesion, double friction_angle,
-                             double dilation_angle, DruckerPragerFit::Kind fit)
-    : Material(std::move(name), elasticity) {
+template <int Dim>
+DruckerPrager<Dim>::DruckerPrager(std::string name, Elasticity elasticity, double cohesion, double friction_angle,
+                                  double dilation_angle, DruckerPragerFit::Kind fit)
+    : Material<Dim>(std::move(name), elasticity) {
   std::tie(alpha_, k_) = DruckerPragerFit::coefficients(fit, cohesion, friction_angle);
   alpha_dilation_ = DruckerPragerFit::coefficients(fit, 0.0, dilation_angle).first;
 }
 
-double DruckerPrager::yield(const Mat<2>& s, double s_zz) const {
-  const auto inv = invariants(s, s_zz);
+template <int Dim>
+double DruckerPrager<Dim>::yield(const Mat<Dim>& s, double s_zz) const {
+  const auto inv = invariants<Dim>(s, s_zz);
   return alpha_ * inv.mean + inv.sqrt_j2 - k_;
 }
 
-double DruckerPrager::return_map(Mat<2>& s, double& s_zz, double* work_density) const {
-  const double g = shear_modulus();
-  return drucker_prager_return(alpha_, k_, alpha_dilation_, g, lame_lambda() + 2.0 / 3.0 * g, s, s_zz, work_density);
+template <int Dim>
+double DruckerPrager<Dim>::return_map(Mat<Dim>& s, double& s_zz, double* work_density) const {
+  const double g = this->shear_modulus();
+  return drucker_prager_return<Dim>(alpha_, k_, alpha_dilation_, g, this->lame_lambda() + 2.0 / 3.0 * g, s, s_zz,
+                                    work_density);
 }
 
-Dissipation DruckerPrager::update_chunk(Particles<2>& p, std::span<const int> members, double dt) const {
+template <int Dim>
+Dissipation DruckerPrager<Dim>::update_chunk(Particles<Dim>& p, std::span<const int> members, double dt) const {
   // Equivalent plastic strain per unit multiplier: sqrt(2/3 |dg/dsigma|^2).
   const double strain_per_multiplier = std::sqrt(2.0 / 3.0 * (0.5 + alpha_dilation_ * alpha_dilation_ / 3));
-  const double lambda = lame_lambda(), shear = shear_modulus();
+  const double lambda = this->lame_lambda(), shear = this->shear_modulus();
   return each_member(p, members, dt, [&](int i) {
-    elastic_trial(lambda, shear, p.velocity_gradient[i], dt, p.stress[i], p.stress_zz[i]);
+    double none = 0;
+    double& zz = out_of_plane<Dim>(p.stress_zz, i, none);
+    elastic_trial<Dim>(lambda, shear, p.velocity_gradient[i], dt, p.stress[i], zz);
     double work = 0;
-    const double multiplier = return_map(p.stress[i], p.stress_zz[i], &work);
+    const double multiplier = return_map(p.stress[i], zz, &work);
     if (multiplier == 0) return Dissipation{};
     p.plastic_strain[i] += strain_per_multiplier * multiplier;
     return Dissipation{p.volume[i] * work, 0};
   });
 }
 
+template class DruckerPrager<2>;
+template class DruckerPrager<3>;
+
 namespace {
 
 using scene::Range;
 
-std::unique_ptr<Material> read(const scene::Table& m, const MaterialContext& context) {
+template <int Dim>
+std::unique_ptr<Material<Dim>> read(const scene::Table& m, const MaterialContext& context) {
   const double c = m.quantity({"cohesion", "Mohr-Coulomb cohesion c", "", Range::non_negative()}, units::pressure);
   const double phi = m.quantity({"friction_angle", "Mohr-Coulomb friction angle", "",
                                  Range{0.0, 1.5, true, false}},
@@ -57,10 +68,13 @@ std::unique_ptr<Material> read(const scene::Table& m, const MaterialContext& con
       {{"outer", DruckerPragerFit::Kind::outer},
        {"inner", DruckerPragerFit::Kind::inner},
        {"plane_strain", DruckerPragerFit::Kind::plane_strain}});
-  return std::make_unique<DruckerPrager>(context.name, context.elasticity, c, phi, psi, kind);
+  if (Dim == 3 && kind == DruckerPragerFit::Kind::plane_strain)
+    m.fail("fit", "\"plane_strain\" matches Mohr-Coulomb's collapse load in plane strain; a 3D scene takes "
+                  "\"outer\" or \"inner\"");
+  return std::make_unique<DruckerPrager<Dim>>(context.name, context.elasticity, c, phi, psi, kind);
 }
 
-[[maybe_unused]] const bool registered = register_material({"drucker_prager", "perfectly plastic", read});
+[[maybe_unused]] const bool registered = register_material({"drucker_prager", "perfectly plastic", read<2>, read<3>});
 
 }  // namespace
 

@@ -3,11 +3,12 @@
 
 namespace outburst::mpm {
 
-// Linear elasticity with the Jaumann stress rate, plane strain.
-class LinearElastic final : public Material {
+// Linear elasticity with the Jaumann stress rate (plane strain in 2D).
+template <int Dim>
+class LinearElastic final : public Material<Dim> {
  public:
-  using Material::Material;
-  Dissipation update_chunk(Particles<2>& p, std::span<const int> members, double dt) const override;
+  using Material<Dim>::Material;
+  Dissipation update_chunk(Particles<Dim>& p, std::span<const int> members, double dt) const override;
 };
 
 }  // namespace outburst::mpm

@@ -7,6 +7,7 @@
 #include <string>
 #include <tuple>
 
+#include <Eigen/Eigenvalues>
 #include <fmt/format.h>
 
 #include "mpm_solid/nonlocal.hpp"
@@ -15,33 +16,67 @@ namespace outburst::mpm {
 
 namespace {
 
-// In-plane principal values (a >= b) and the unit vector of a.
-struct Principal {
-  double a, b;
-  Vec<2> direction;
-};
-
-Principal principal(const Mat<2>& s) {
-  const double centre = 0.5 * (s(0, 0) + s(1, 1));
-  const double half = 0.5 * (s(0, 0) - s(1, 1));
-  const double radius = std::sqrt(half * half + s(0, 1) * s(0, 1));
-  if (radius == 0) return {centre, centre, Vec<2>(1, 0)};
-  // Half-angle formulas from cos 2t = half / radius, sin 2t = s_xy / radius:
-  // no trigonometric calls in the innermost loop of the damage law.
-  const double cos2 = half / radius;
-  const double c = std::sqrt(0.5 * (1 + cos2)), sn = std::copysign(std::sqrt(0.5 * (1 - cos2)), s(0, 1));
-  return {centre + radius, centre - radius, Vec<2>(c, sn)};
-}
-
-Mat<2> compose(double a, double b, const Vec<2>& direction) {
-  const Vec<2> normal(-direction.y(), direction.x());
-  return a * direction * direction.transpose() + b * normal * normal.transpose();
-}
-
 // Open cracks: tensile principal parts scaled by (1 - D) (or back, by 1/(1 - D)).
 double crack(double principal_value, double factor) {
   return principal_value > 0 ? factor * principal_value : principal_value;
 }
+
+// The principal decomposition of a stress matrix (the in-plane one under
+// plane strain), and the stress whose tensile principal parts are scaled.
+template <int Dim>
+struct Principal;
+
+template <>
+struct Principal<2> {
+  double a, b;       // a >= b
+  Vec<2> direction;  // of a
+  explicit Principal(const Mat<2>& s) {
+    const double centre = 0.5 * (s(0, 0) + s(1, 1));
+    const double half = 0.5 * (s(0, 0) - s(1, 1));
+    const double radius = std::sqrt(half * half + s(0, 1) * s(0, 1));
+    if (radius == 0) {
+      a = b = centre;
+      direction = Vec<2>(1, 0);
+      return;
+    }
+    // Half-angle formulas from cos 2t = half / radius, sin 2t = s_xy / radius:
+    // no trigonometric calls in the innermost loop of the damage law.
+    const double cos2 = half / radius;
+    const double c = std::sqrt(0.5 * (1 + cos2)), sn = std::copysign(std::sqrt(0.5 * (1 - cos2)), s(0, 1));
+    a = centre + radius;
+    b = centre - radius;
+    direction = Vec<2>(c, sn);
+  }
+  double largest() const { return a; }
+  double smallest() const { return b; }
+  double sum() const { return a + b; }
+  Mat<2> cracked(double factor) const {
+    const Vec<2> normal(-direction.y(), direction.x());
+    return crack(a, factor) * direction * direction.transpose() + crack(b, factor) * normal * normal.transpose();
+  }
+};
+
+template <>
+struct Principal<3> {
+  Vec<3> values;  // ascending
+  Mat<3> axes;    // the columns
+  explicit Principal(const Mat<3>& s) {
+    // The closed form for 3 x 3: one per particle and step, where the
+    // iterative solver costs several times more.
+    Eigen::SelfAdjointEigenSolver<Mat<3>> solver;
+    solver.computeDirect(s);
+    values = solver.eigenvalues();
+    axes = solver.eigenvectors();
+  }
+  double largest() const { return values[2]; }
+  double smallest() const { return values[0]; }
+  double sum() const { return values.sum(); }
+  Mat<3> cracked(double factor) const {
+    Vec<3> v;
+    for (int k = 0; k < 3; ++k) v[k] = crack(values[k], factor);
+    return axes * v.asDiagonal() * axes.transpose();
+  }
+};
 
 }  // namespace
 
@@ -50,8 +85,9 @@ double largest_band_width(const DamageParameters& d, const Elasticity& e) {
                            : std::numeric_limits<double>::infinity();
 }
 
-ElasticDamage::ElasticDamage(std::string name, Elasticity elasticity, DamageParameters damage)
-    : Material(std::move(name), elasticity), parameters_(damage) {
+template <int Dim>
+ElasticDamage<Dim>::ElasticDamage(std::string name, Elasticity elasticity, DamageParameters damage)
+    : Material<Dim>(std::move(name), elasticity), parameters_(damage) {
   if (!damage.fracture_energy) {
     ultimate_strain_ = damage.ultimate_ratio * (damage.tensile_strength / elasticity.youngs_modulus);
   } else {
@@ -103,13 +139,25 @@ double weibull_modulus_scale(const DamageParameters::Heterogeneity& h, std::int6
   return weibull(h.modulus_index(), mix(strength_bits(h, id)));
 }
 
-std::int64_t DamageParameters::Heterogeneity::key(std::int64_t id, const Vec<2>& x0) const {
+template <int Dim>
+std::int64_t DamageParameters::Heterogeneity::key(std::int64_t id, const Vec<Dim>& x0) const {
   if (!grain_size) return id;
   const auto index = [&](double x) { return static_cast<std::uint32_t>(static_cast<std::int32_t>(std::floor(x / *grain_size))); };
-  return static_cast<std::int64_t>((static_cast<std::uint64_t>(index(x0[0])) << 32) | index(x0[1]));
+  if constexpr (Dim == 2) {
+    return static_cast<std::int64_t>((static_cast<std::uint64_t>(index(x0[0])) << 32) | index(x0[1]));
+  } else {
+    // 21 bits of each index: grains across two million grain sizes before
+    // two share a key.
+    const auto bits = [&](double x) { return static_cast<std::uint64_t>(index(x) & 0x1fffffu); };
+    return static_cast<std::int64_t>((bits(x0[0]) << 42) | (bits(x0[1]) << 21) | bits(x0[2]));
+  }
 }
 
-void ElasticDamage::create_fields(Particles<2>& p, const std::vector<int>& members) const {
+template std::int64_t DamageParameters::Heterogeneity::key<2>(std::int64_t, const Vec<2>&) const;
+template std::int64_t DamageParameters::Heterogeneity::key<3>(std::int64_t, const Vec<3>&) const;
+
+template <int Dim>
+void ElasticDamage<Dim>::create_fields(Particles<Dim>& p, const std::vector<int>& members) const {
   p.need_plastic_strain();
   p.need_damage();
   if (parameters_.internal_length) p.need("nonlocal damage");
@@ -117,35 +165,48 @@ void ElasticDamage::create_fields(Particles<2>& p, const std::vector<int>& membe
   p.need("heterogeneity");
   const auto& h = *parameters_.heterogeneity;
   for (const int i : members) {
-    p.strength_scale[i] = weibull_strength_scale(h, h.key(p.id[i], p.x0[i]));
-    p.modulus_scale[i] = weibull_modulus_scale(h, h.key(p.id[i], p.x0[i]));
+    p.strength_scale[i] = weibull_strength_scale(h, h.key<Dim>(p.id[i], p.x0[i]));
+    p.modulus_scale[i] = weibull_modulus_scale(h, h.key<Dim>(p.id[i], p.x0[i]));
   }
 }
 
-struct ElasticDamage::Stresses {
+template <int Dim>
+struct ElasticDamage<Dim>::Stresses {
   double s1, s2, s3;    // s1 >= s2 >= s3, out-of-plane included
   double eps1, eps3;    // the strains along s1 and s3
 };
 
-ElasticDamage::Stresses ElasticDamage::principal_stresses(const Mat<2>& effective, double effective_zz,
-                                                          double stiffness) const {
-  const double e0 = stiffness * elasticity().youngs_modulus, nu = elasticity().poisson_ratio;
-  const Principal pr = principal(effective);
-  const double s1 = std::max(pr.a, effective_zz), s3 = std::min(pr.b, effective_zz);
-  const double s2 = pr.a + pr.b + effective_zz - s1 - s3;
+template <int Dim>
+typename ElasticDamage<Dim>::Stresses ElasticDamage<Dim>::principal_stresses(const Mat<Dim>& effective,
+                                                                             double effective_zz,
+                                                                             double stiffness) const {
+  const double e0 = stiffness * this->elasticity().youngs_modulus, nu = this->elasticity().poisson_ratio;
+  const Principal<Dim> pr(effective);
+  double s1, s2, s3;
+  if constexpr (Dim == 2) {
+    s1 = std::max(pr.largest(), effective_zz);
+    s3 = std::min(pr.smallest(), effective_zz);
+    s2 = pr.sum() + effective_zz - s1 - s3;
+  } else {
+    s1 = pr.values[2];
+    s2 = pr.values[1];
+    s3 = pr.values[0];
+  }
   return {s1, s2, s3, (s1 - nu * (s2 + s3)) / e0, (s3 - nu * (s1 + s2)) / e0};
 }
 
-double ElasticDamage::shear_damage(const Stresses& s, double scale, double stiffness) const {
+template <int Dim>
+double ElasticDamage<Dim>::shear_damage(const Stresses& s, double scale, double stiffness) const {
   const auto& d = parameters_;
   if (0.5 * (s.s1 - s.s3) < scale * d.cohesion * cos_phi_ - 0.5 * (s.s1 + s.s3) * sin_phi_ || s.eps3 >= 0) return 0;
-  return 1 - d.residual_ratio * scale * ucs_ / (stiffness * elasticity().youngs_modulus * -s.eps3);
+  return 1 - d.residual_ratio * scale * ucs_ / (stiffness * this->elasticity().youngs_modulus * -s.eps3);
 }
 
-double ElasticDamage::damage(double previous, const Mat<2>& effective, double effective_zz, double scale,
-                             double stiffness) const {
+template <int Dim>
+double ElasticDamage<Dim>::damage(double previous, const Mat<Dim>& effective, double effective_zz, double scale,
+                                  double stiffness) const {
   const auto& d = parameters_;
-  const double e0 = stiffness * elasticity().youngs_modulus;
+  const double e0 = stiffness * this->elasticity().youngs_modulus;
   const Stresses st = principal_stresses(effective, effective_zz, stiffness);
   const double s1 = st.s1, eps1 = st.eps1;
   double damage = previous;
@@ -174,56 +235,66 @@ double ElasticDamage::damage(double previous, const Mat<2>& effective, double ef
   return std::clamp(std::max(damage, shear_damage(st, scale, stiffness)), 0.0, 1.0);
 }
 
-double ElasticDamage::driving_strain(const Mat<2>& effective, double effective_zz, double scale,
-                                     double stiffness) const {
-  const double at_strength = scale * parameters_.tensile_strength / (stiffness * elasticity().youngs_modulus);
+template <int Dim>
+double ElasticDamage<Dim>::driving_strain(const Mat<Dim>& effective, double effective_zz, double scale,
+                                          double stiffness) const {
+  const double at_strength = scale * parameters_.tensile_strength / (stiffness * this->elasticity().youngs_modulus);
   return std::clamp(principal_stresses(effective, effective_zz, stiffness).eps1 / at_strength, 0.0,
                     parameters_.ultimate_ratio);
 }
 
-double ElasticDamage::nonlocal_tensile_damage(double averaged) const {
+template <int Dim>
+double ElasticDamage<Dim>::nonlocal_tensile_damage(double averaged) const {
   const double eta = parameters_.ultimate_ratio;
   if (averaged <= 1) return 0;
   if (averaged >= eta) return 1;
   return 1 - (eta - averaged) / ((eta - 1) * averaged);
 }
 
-double ElasticDamage::strength_scale(const Particles<2>& p, int i) const {
+template <int Dim>
+double ElasticDamage<Dim>::strength_scale(const Particles<Dim>& p, int i) const {
   return parameters_.heterogeneity ? p.strength_scale[i] : 1.0;
 }
 
-double ElasticDamage::modulus_scale(const Particles<2>& p, int i) const {
+template <int Dim>
+double ElasticDamage<Dim>::modulus_scale(const Particles<Dim>& p, int i) const {
   return parameters_.heterogeneity ? p.modulus_scale[i] : 1.0;
 }
 
-void ElasticDamage::trial(Particles<2>& p, int i, double dt) const {
+template <int Dim>
+void ElasticDamage<Dim>::trial(Particles<Dim>& p, int i, double dt) const {
   const double stiffness = modulus_scale(p, i);  // lambda and G scale with E
-  elastic_trial(stiffness * lame_lambda(), stiffness * shear_modulus(), p.velocity_gradient[i], dt,
-                p.effective_stress[i], p.effective_stress_zz[i]);
+  double none = 0;
+  elastic_trial<Dim>(stiffness * this->lame_lambda(), stiffness * this->shear_modulus(), p.velocity_gradient[i], dt,
+                     p.effective_stress[i], out_of_plane<Dim>(p.effective_stress_zz, i, none));
 }
 
 // The acting stress at damage d, what the growth of damage took, and the
 // friction of compressive states.
-Dissipation ElasticDamage::settle(Particles<2>& p, int i, double d) const {
+template <int Dim>
+Dissipation ElasticDamage<Dim>::settle(Particles<Dim>& p, int i, double d) const {
   const double stiffness = modulus_scale(p, i);
-  const double g = stiffness * shear_modulus();
-  const double bulk = stiffness * lame_lambda() + 2.0 / 3.0 * g;
+  const double g = stiffness * this->shear_modulus();
+  const double bulk = stiffness * this->lame_lambda() + 2.0 / 3.0 * g;
   Dissipation dissipated;
-  Mat<2>& effective = p.effective_stress[i];
-  double& effective_zz = p.effective_stress_zz[i];
+  Mat<Dim>& effective = p.effective_stress[i];
+  double none = 0;
+  double& effective_zz = out_of_plane<Dim>(p.effective_stress_zz, i, none);
   const double previous = p.damage[i];
   p.damage[i] = d;
-  // The stress acting: open cracks carry no share of tension.
-  const Principal pr = principal(effective);
-  Mat<2> s = compose(crack(pr.a, 1 - d), crack(pr.b, 1 - d), pr.direction);
+  // The stress acting: open cracks carry no share of tension. (Undamaged 3D
+  // coal keeps its stress: a decomposition and recomposition would move it
+  // by roundoff every step.)
+  const Principal<Dim> pr(effective);
+  Mat<Dim> s = Dim == 3 && d == 0 ? effective : pr.cracked(1 - d);
   double s_zz = crack(effective_zz, 1 - d);
   if (d > previous) {
     // Y dD: the energy the cracks take at the strain they opened at.
-    const Mat<2> before = compose(crack(pr.a, 1 - previous), crack(pr.b, 1 - previous), pr.direction);
+    const Mat<Dim> before = pr.cracked(1 - previous);
     const double before_zz = crack(effective_zz, 1 - previous);
     dissipated.damage = 0.5 * p.volume[i] *
-                        (compliance_product(before, before_zz, effective, effective_zz) -
-                         compliance_product(s, s_zz, effective, effective_zz)) /
+                        (this->compliance_product(before, before_zz, effective, effective_zz) -
+                         this->compliance_product(s, s_zz, effective, effective_zz)) /
                         stiffness;
   }
   // Friction bounds compressive states, with the cohesion the cracks leave;
@@ -232,42 +303,43 @@ Dissipation ElasticDamage::settle(Particles<2>& p, int i, double d) const {
   double work = 0;
   const bool compressive = s.trace() + s_zz < 0;
   if (const double multiplier =
-          compressive ? drucker_prager_return(alpha_, (1 - d) * strength_scale(p, i) * k0_, 0.0, g, bulk, s, s_zz, &work)
+          compressive ? drucker_prager_return<Dim>(alpha_, (1 - d) * strength_scale(p, i) * k0_, 0.0, g, bulk, s, s_zz, &work)
                       : 0.0;
       multiplier > 0) {
     p.plastic_strain[i] += multiplier / std::sqrt(3.0);  // no dilation: sqrt(2/3 |dg/dsigma|^2) = 1/sqrt(3)
     dissipated.plastic = p.volume[i] * work;
     // Carry the return back to the undamaged stress (same principal axes).
-    const Principal back = principal(s);
+    const Principal<Dim> back(s);
     const double open = d < 1 ? 1 / (1 - d) : 0.0;
-    effective = compose(crack(back.a, open), crack(back.b, open), back.direction);
+    effective = back.cracked(open);
     effective_zz = crack(s_zz, open);
   }
   p.stress[i] = s;
-  p.stress_zz[i] = s_zz;
+  if constexpr (Dim == 2) p.stress_zz[i] = s_zz;
   if (d >= 1) p.volume[i] = std::min(p.volume[i], parameters_.bulking_factor * p.volume0[i]);
   return dissipated;
 }
 
-Dissipation ElasticDamage::update_chunk(Particles<2>& p, std::span<const int> members, double dt) const {
+template <int Dim>
+Dissipation ElasticDamage<Dim>::update_chunk(Particles<Dim>& p, std::span<const int> members, double dt) const {
   if (!pointwise()) throw std::logic_error("nonlocal damage updates a material's particles together (update_stress)");
   return each_member(p, members, dt, [&](int i) {
     trial(p, i, dt);
-    return settle(p, i,
-                  damage(p.damage[i], p.effective_stress[i], p.effective_stress_zz[i], strength_scale(p, i),
-                         modulus_scale(p, i)));
+    const double zz = Dim == 2 ? p.effective_stress_zz[i] : 0.0;
+    return settle(p, i, damage(p.damage[i], p.effective_stress[i], zz, strength_scale(p, i), modulus_scale(p, i)));
   });
 }
 
-Dissipation ElasticDamage::update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const {
-  if (pointwise()) return Material::update_stress(p, members, dt);
+template <int Dim>
+Dissipation ElasticDamage<Dim>::update_stress(Particles<Dim>& p, const std::vector<int>& members, double dt) const {
+  if (pointwise()) return Material<Dim>::update_stress(p, members, dt);
   // Nonlocal: every member's trial stress and driving strain first, then
   // their averages over the internal length, then the damage.
   over_chunks(members, [&](std::span<const int> part) {
     return each_member(p, part, dt, [&](int i) {
       trial(p, i, dt);
-      p.nonlocal_strain[i] = driving_strain(p.effective_stress[i], p.effective_stress_zz[i], strength_scale(p, i),
-                                            modulus_scale(p, i));
+      const double zz = Dim == 2 ? p.effective_stress_zz[i] : 0.0;
+      p.nonlocal_strain[i] = driving_strain(p.effective_stress[i], zz, strength_scale(p, i), modulus_scale(p, i));
       return Dissipation{};
     });
   });
@@ -285,7 +357,7 @@ Dissipation ElasticDamage::update_stress(Particles<2>& p, const std::vector<int>
     const int i = members[k];
     p.nonlocal_strain[i] = averaged[k];
     const double stiffness = modulus_scale(p, i);
-    const Stresses st = principal_stresses(p.effective_stress[i], p.effective_stress_zz[i], stiffness);
+    const Stresses st = principal_stresses(p.effective_stress[i], Dim == 2 ? p.effective_stress_zz[i] : 0.0, stiffness);
     const double d = std::clamp(std::max({p.damage[i], nonlocal_tensile_damage(averaged[k]),
                                           shear_damage(st, strength_scale(p, i), stiffness)}),
                                 0.0, 1.0);
@@ -296,19 +368,24 @@ Dissipation ElasticDamage::update_stress(Particles<2>& p, const std::vector<int>
   return {plastic, damaged};
 }
 
-double ElasticDamage::strain_energy(const Particles<2>& p, const std::vector<int>& members) const {
+template <int Dim>
+double ElasticDamage<Dim>::strain_energy(const Particles<Dim>& p, const std::vector<int>& members) const {
   return sum_over(members, [&](int i) {
-    return 0.5 * p.volume[i] *
-           compliance_product(p.stress[i], p.stress_zz[i], p.effective_stress[i], p.effective_stress_zz[i]) /
+    const double zz = Dim == 2 ? p.stress_zz[i] : 0.0, effective_zz = Dim == 2 ? p.effective_stress_zz[i] : 0.0;
+    return 0.5 * p.volume[i] * this->compliance_product(p.stress[i], zz, p.effective_stress[i], effective_zz) /
            modulus_scale(p, i);
   });
 }
+
+template class ElasticDamage<2>;
+template class ElasticDamage<3>;
 
 namespace {
 
 using scene::Range;
 
-std::unique_ptr<Material> read(const scene::Table& m, const MaterialContext& c) {
+template <int Dim>
+std::unique_ptr<Material<Dim>> read(const scene::Table& m, const MaterialContext& c) {
   DamageParameters d{};
   d.cohesion = m.quantity({"cohesion", "Mohr-Coulomb cohesion c of the intact coal", "", Range::positive()},
                           units::pressure);
@@ -401,11 +478,11 @@ std::unique_ptr<Material> read(const scene::Table& m, const MaterialContext& c) 
                                         units::length))
             : std::nullopt};
   }
-  return std::make_unique<ElasticDamage>(c.name, c.elasticity, d);
+  return std::make_unique<ElasticDamage<Dim>>(c.name, c.elasticity, d);
 }
 
 [[maybe_unused]] const bool registered =
-    register_material({"elastic_damage", "brittle, leaving granular fragments", read});
+    register_material({"elastic_damage", "brittle, leaving granular fragments", read<2>, read<3>});
 
 }  // namespace
 

@@ -86,7 +86,8 @@ struct DamageParameters {
     std::optional<double> grain_size = std::nullopt;
     double modulus_index() const { return modulus_homogeneity_index.value_or(homogeneity_index); }
     // What the draws of a particle of this id, at x0 at t = 0, are hashed from.
-    std::int64_t key(std::int64_t id, const Vec<2>& x0) const;
+    template <int Dim>
+    std::int64_t key(std::int64_t id, const Vec<Dim>& x0) const;
   };
   std::optional<Heterogeneity> heterogeneity = std::nullopt;
 };
@@ -101,20 +102,24 @@ double weibull_modulus_scale(const DamageParameters::Heterogeneity& h, std::int6
 // (then eps_tu = eps_t0).
 double largest_band_width(const DamageParameters& d, const Elasticity& e);
 
-class ElasticDamage final : public Material {
+// The plane forms read the principal stresses of the in-plane matrix and the
+// out-of-plane stress; the 3D ones those of the whole matrix.
+template <int Dim>
+class ElasticDamage final : public Material<Dim> {
  public:
   ElasticDamage(std::string name, Elasticity elasticity, DamageParameters damage);
-  void create_fields(Particles<2>& p, const std::vector<int>& members) const override;
-  Dissipation update_stress(Particles<2>& p, const std::vector<int>& members, double dt) const override;
-  Dissipation update_chunk(Particles<2>& p, std::span<const int> members, double dt) const override;
+  void create_fields(Particles<Dim>& p, const std::vector<int>& members) const override;
+  Dissipation update_stress(Particles<Dim>& p, const std::vector<int>& members, double dt) const override;
+  Dissipation update_chunk(Particles<Dim>& p, std::span<const int> members, double dt) const override;
   // Nonlocal damage reads the neighbours' strains.
   bool pointwise() const override { return !parameters_.internal_length; }
-  // Damage of one particle, given its history value, effective stress and
-  // factors on the strengths and the moduli.
-  double damage(double previous, const Mat<2>& effective, double effective_zz, double scale = 1.0,
+  // Damage of one particle, given its history value, effective stress
+  // (effective_zz: plane strain's, ignored in 3D) and factors on the
+  // strengths and the moduli.
+  double damage(double previous, const Mat<Dim>& effective, double effective_zz, double scale = 1.0,
                 double stiffness = 1.0) const;
   const DamageParameters& parameters() const { return parameters_; }
-  double strain_energy(const Particles<2>& p, const std::vector<int>& members) const override;
+  double strain_energy(const Particles<Dim>& p, const std::vector<int>& members) const override;
 
  private:
   DamageParameters parameters_;
@@ -122,19 +127,19 @@ class ElasticDamage final : public Material {
   double alpha_, k0_;       // Drucker-Prager friction cone (outer fit), intact cohesion
   double sin_phi_, cos_phi_, ucs_;  // of the Mohr-Coulomb shear criterion
 
-  double strength_scale(const Particles<2>& p, int i) const;  // s_f, 1 unless heterogeneous
-  double modulus_scale(const Particles<2>& p, int i) const;   // s_E
+  double strength_scale(const Particles<Dim>& p, int i) const;  // s_f, 1 unless heterogeneous
+  double modulus_scale(const Particles<Dim>& p, int i) const;   // s_E
   // The elastic trial of particle i's undamaged stress over dt.
-  void trial(Particles<2>& p, int i, double dt) const;
+  void trial(Particles<Dim>& p, int i, double dt) const;
   // Sets particle i's damage to d (no less than it had) and its acting
   // stress, and returns what that dissipated.
-  Dissipation settle(Particles<2>& p, int i, double d) const;
+  Dissipation settle(Particles<Dim>& p, int i, double d) const;
   struct Stresses;  // ordered principal stresses, with the strains they hold
-  Stresses principal_stresses(const Mat<2>& effective, double effective_zz, double stiffness) const;
+  Stresses principal_stresses(const Mat<Dim>& effective, double effective_zz, double stiffness) const;
   double shear_damage(const Stresses& s, double scale, double stiffness) const;
   // The local driver of nonlocal damage: eps_1 over the strain at f_t, in
   // [0, eta].
-  double driving_strain(const Mat<2>& effective, double effective_zz, double scale, double stiffness) const;
+  double driving_strain(const Mat<Dim>& effective, double effective_zz, double scale, double stiffness) const;
   // Tensile damage of nonlocal damage from the averaged driving strain.
   double nonlocal_tensile_damage(double averaged) const;
 };
