@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <tuple>
@@ -181,16 +182,20 @@ typename ElasticDamage<Dim>::Stresses ElasticDamage<Dim>::principal_stresses(con
                                                                              double effective_zz,
                                                                              double stiffness) const {
   const double e0 = stiffness * this->elasticity().youngs_modulus, nu = this->elasticity().poisson_ratio;
-  const Principal<Dim> pr(effective);
   double s1, s2, s3;
   if constexpr (Dim == 2) {
+    const Principal<Dim> pr(effective);
     s1 = std::max(pr.largest(), effective_zz);
     s3 = std::min(pr.smallest(), effective_zz);
     s2 = pr.sum() + effective_zz - s1 - s3;
   } else {
-    s1 = pr.values[2];
-    s2 = pr.values[1];
-    s3 = pr.values[0];
+    // The values alone: the closed form is accurate for them, less so for
+    // the axes of nearly equal ones.
+    Eigen::SelfAdjointEigenSolver<Mat<3>> solver;
+    solver.computeDirect(effective, Eigen::EigenvaluesOnly);
+    s1 = solver.eigenvalues()[2];
+    s2 = solver.eigenvalues()[1];
+    s3 = solver.eigenvalues()[0];
   }
   return {s1, s2, s3, (s1 - nu * (s2 + s3)) / e0, (s3 - nu * (s1 + s2)) / e0};
 }
@@ -282,15 +287,18 @@ Dissipation ElasticDamage<Dim>::settle(Particles<Dim>& p, int i, double d) const
   double& effective_zz = out_of_plane<Dim>(p.effective_stress_zz, i, none);
   const double previous = p.damage[i];
   p.damage[i] = d;
-  // The stress acting: open cracks carry no share of tension. (Undamaged 3D
-  // coal keeps its stress: a decomposition and recomposition would move it
-  // by roundoff every step.)
-  const Principal<Dim> pr(effective);
-  Mat<Dim> s = Dim == 3 && d == 0 ? effective : pr.cracked(1 - d);
+  // The stress acting: open cracks carry no share of tension. Intact 3D coal
+  // (d = 0, and no less before) acts with its undamaged stress as it is: a
+  // decomposition and recomposition would move it by roundoff every step,
+  // and the closed form's axes by more where principal values nearly agree.
+  const bool intact = Dim == 3 && d == 0;
+  std::optional<Principal<Dim>> pr;
+  if (!intact) pr.emplace(effective);
+  Mat<Dim> s = intact ? effective : pr->cracked(1 - d);
   double s_zz = crack(effective_zz, 1 - d);
   if (d > previous) {
     // Y dD: the energy the cracks take at the strain they opened at.
-    const Mat<Dim> before = pr.cracked(1 - previous);
+    const Mat<Dim> before = pr->cracked(1 - previous);
     const double before_zz = crack(effective_zz, 1 - previous);
     dissipated.damage = 0.5 * p.volume[i] *
                         (this->compliance_product(before, before_zz, effective, effective_zz) -
@@ -309,10 +317,14 @@ Dissipation ElasticDamage<Dim>::settle(Particles<Dim>& p, int i, double d) const
     p.plastic_strain[i] += multiplier / std::sqrt(3.0);  // no dilation: sqrt(2/3 |dg/dsigma|^2) = 1/sqrt(3)
     dissipated.plastic = p.volume[i] * work;
     // Carry the return back to the undamaged stress (same principal axes).
-    const Principal<Dim> back(s);
-    const double open = d < 1 ? 1 / (1 - d) : 0.0;
-    effective = back.cracked(open);
-    effective_zz = crack(s_zz, open);
+    if (intact) {
+      effective = s;
+    } else {
+      const Principal<Dim> back(s);
+      const double open = d < 1 ? 1 / (1 - d) : 0.0;
+      effective = back.cracked(open);
+      effective_zz = crack(s_zz, open);
+    }
   }
   p.stress[i] = s;
   if constexpr (Dim == 2) p.stress_zz[i] = s_zz;
