@@ -674,8 +674,10 @@ void Solver<Dim>::fold_ghosts(std::vector<double>* mass, std::vector<Vec<Dim>>& 
 // takes the condition; ghost nodes beyond it mirror the node inside, with the
 // constrained components reflected oddly, so the interpolated velocity meets the
 // condition at the wall itself and not half a cell inside (which costs wide
-// shape functions a whole order of accuracy). Obstacles follow. Returns the
-// work done by friction.
+// shape functions a whole order of accuracy). Obstacles act between the wall
+// rows and the ghost rows: a ghost mirrors an obstacle's node as the obstacle
+// leaves it (read before, its velocity changed where no energy book saw it).
+// Returns the work done by friction.
 template <int Dim>
 double Solver<Dim>::apply_walls(std::vector<Vec<Dim>>& velocity) const {
   const int g = Grid<Dim>::ghost;
@@ -704,12 +706,14 @@ double Solver<Dim>::apply_walls(std::vector<Vec<Dim>>& velocity) const {
         friction_work += constrain(v, normal, wall, mass_[i]);
       });
     }
+    if (depth > 0) continue;
+    // Most of an obstacle's nodes lie deep in the rock, where no particle
+    // reaches: at rest, which every contact leaves at rest.
+    for (const auto& o : obstacle_nodes_)
+      if (const Vec<Dim>& v = velocity[o.node]; (v.array() != 0).any())
+        friction_work +=
+            constrain(velocity[o.node], o.normal, settings_.obstacles[o.obstacle].contact, mass_[o.node]);
   }
-  // Most of an obstacle's nodes lie deep in the rock, where no particle
-  // reaches: at rest, which every contact leaves at rest.
-  for (const auto& o : obstacle_nodes_)
-    if (const Vec<Dim>& v = velocity[o.node]; (v.array() != 0).any())
-      friction_work += constrain(velocity[o.node], o.normal, settings_.obstacles[o.obstacle].contact, mass_[o.node]);
   return friction_work;
 }
 
