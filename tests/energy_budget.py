@@ -41,16 +41,18 @@ def main():
         if bad:
             sys.exit(f"{path}: t = {r['time_s']:g} s: non-finite {', '.join(bad)}")
     first = rows[0]
+    # Plane runs book per metre of depth; 3D runs whole joules.
+    suffix, unit = ("_J_per_m", "J/m") if "kinetic_J_per_m" in first else ("_J", "J")
     stored = {"kinetic", "strain", "gravity"}
-    largest = max(abs(r[f"{t}_J_per_m"] - (first[f"{t}_J_per_m"] if t in stored else 0)) for r in rows for t in TERMS)
-    worst = max(rows, key=lambda r: abs(r["balance_error_J_per_m"]))
-    share = abs(worst["balance_error_J_per_m"]) / max(largest, 1e-300)
-    step = max(abs(r["integration_J_per_m"] - first["integration_J_per_m"]) for r in rows) / max(largest, 1e-300)
+    largest = max(abs(r[t + suffix] - (first[t + suffix] if t in stored else 0)) for r in rows for t in TERMS)
+    worst = max(rows, key=lambda r: abs(r["balance_error" + suffix]))
+    share = abs(worst["balance_error" + suffix]) / max(largest, 1e-300)
+    step = max(abs(r["integration" + suffix] - first["integration" + suffix]) for r in rows) / max(largest, 1e-300)
     last = rows[-1]
-    print(f"{path}: {len(rows)} outputs to t = {last['time_s']:g} s; largest term {largest:.4g} J/m; balance error at "
-          f"most {worst['balance_error_J_per_m']:+.4g} J/m ({share:.2%} of it, t = {worst['time_s']:g} s); "
-          f"time step's own error at most {step:.2%}; at the end transfer {last['transfer_J_per_m']:.4g} J/m, "
-          f"time step {last['integration_J_per_m']:.4g} J/m, walls {last['walls_J_per_m']:.4g} J/m")
+    print(f"{path}: {len(rows)} outputs to t = {last['time_s']:g} s; largest term {largest:.4g} {unit}; balance error "
+          f"at most {worst['balance_error' + suffix]:+.4g} {unit} ({share:.2%} of it, t = {worst['time_s']:g} s); "
+          f"time step's own error at most {step:.2%}; at the end transfer {last['transfer' + suffix]:.4g} {unit}, "
+          f"time step {last['integration' + suffix]:.4g} {unit}, walls {last['walls' + suffix]:.4g} {unit}")
     if share > args.most_open:
         sys.exit(f"energy books open by {share:.2%} of the largest term (at most {args.most_open:.2%})")
     if step > args.most_step:

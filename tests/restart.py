@@ -47,6 +47,11 @@ CASES = [
     Case("elastic block, 2 threads", "mpm_solid/mpm-solid", "elastic_block/elastic_block.toml",
          ['scene.end_time="0.04 s"', 'output.checkpoint_interval="0.001 s"'], 2,
          [(signal.SIGKILL, "run")], ["particles.xdmf"], ["mpm_history.csv", "tracers.csv"]),
+    # 3D, two threads: the threads' scatter buffers over blocks of 4 x 4 x 4 nodes.
+    Case("3D heading, 2 threads", "mpm_solid/mpm-solid", "elastic_block_3d/elastic_block_3d.toml",
+         ['scene.end_time="0.01 s"', 'mpm.grid.cell_size="1 m"', 'output.interval="0.002 s"',
+          'output.checkpoint_interval="0.0005 s"'], 2,
+         [(signal.SIGKILL, "run")], ["particles.xdmf"], ["mpm_history.csv", "tracers.csv"]),
     # A settling stage of mpm-solid's own.
     Case("elastic block, settling", "mpm_solid/mpm-solid", "elastic_block/elastic_block.toml",
          ['mpm.settle.time="0.02 s"', 'output.checkpoint_interval="1 ms"'], 1,

@@ -1,12 +1,15 @@
 #!/usr/bin/python3
 """Check that the MPM time step's own energy error (integration_J_per_m in
-mpm_history.csv) falls at the order expected when the step is halved.
+mpm_history.csv, integration_J in 3D) falls at the order expected when the step is halved.
 
-usage: step_error_order.py COARSE_DIR FINE_DIR [--order 1] [--slack 0.2]
+usage: step_error_order.py COARSE_DIR FINE_DIR [--order 1] [--slack 0.2] [--at-least ORDER]
 
 Both runs cover the same time with the fine run's step half the coarse one's.
 The measure is the largest |integration| over each run; the order observed is
-log2 of their ratio and must lie within slack of the order expected.
+log2 of their ratio and must lie within slack of the order expected, or with
+--at-least be no lower than that (a step's error still falling faster than
+first order, as over a short run whose release transient dominates, shows the
+books as well: a wrong book does not fall).
 """
 import argparse
 import csv
@@ -22,7 +25,8 @@ def largest_step_error(directory):
     if not rows:
         sys.exit(f"{directory}: no rows")
     steps = sorted(float(r["dt_s"]) for r in rows)
-    return (max(abs(float(r["integration_J_per_m"])) for r in rows), float(rows[-1]["time_s"]),
+    column = "integration_J_per_m" if "integration_J_per_m" in rows[0] else "integration_J"
+    return (max(abs(float(r[column])) for r in rows), float(rows[-1]["time_s"]),
             steps[len(steps) // 2])
 
 
@@ -32,6 +36,7 @@ def main():
     ap.add_argument("fine")
     ap.add_argument("--order", type=float, default=1.0)
     ap.add_argument("--slack", type=float, default=0.2)
+    ap.add_argument("--at-least", type=float)
     args = ap.parse_args()
     (coarse, t_coarse, dt_coarse), (fine, t_fine, dt_fine) = largest_step_error(args.coarse), largest_step_error(args.fine)
     if not math.isclose(t_coarse, t_fine, rel_tol=1e-6):
@@ -42,10 +47,11 @@ def main():
     if fine <= 0 or coarse <= 0:
         sys.exit("a run shows no time step error at all: the books cannot be measuring it")
     order = math.log2(coarse / fine)
-    print(f"largest time step error {coarse:.4g} J/m, with half the step {fine:.4g} J/m: order {order:.2f} "
-          f"(expected {args.order:g} +- {args.slack:g})")
-    if abs(order - args.order) > args.slack:
-        sys.exit(f"observed order {order:.2f} is not {args.order:g} +- {args.slack:g}")
+    expected = f"at least {args.at_least:g}" if args.at_least is not None else f"{args.order:g} +- {args.slack:g}"
+    print(f"largest time step error {coarse:.4g}, with half the step {fine:.4g} (J/m, or J in 3D): order {order:.2f} "
+          f"(expected {expected})")
+    if order < args.at_least if args.at_least is not None else abs(order - args.order) > args.slack:
+        sys.exit(f"observed order {order:.2f} is not {expected}")
 
 
 if __name__ == "__main__":
