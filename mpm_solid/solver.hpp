@@ -216,6 +216,10 @@ template <int Dim>
 double stable_time_step(const std::vector<std::unique_ptr<Material<Dim>>>& materials,
                         const Particles<Dim>& particles, double h, double courant);
 
+struct SolverMemory {
+  std::size_t particles, grid;  // [bytes]
+};
+
 template <int Dim>
 class Solver {
  public:
@@ -295,9 +299,7 @@ class Solver {
 
   // Memory held now [bytes]: by the particles (every field, and the per-step
   // arrays sized by them) and by the grid (the nodal arrays, one set per thread).
-  struct Memory {
-    std::size_t particles, grid;
-  };
+  using Memory = SolverMemory;
   Memory memory() const;
 
   Energies energies() const;

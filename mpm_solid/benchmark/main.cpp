@@ -80,42 +80,57 @@ double unloaded_particle_steps_per_second(long particles) {
 
 struct Measured {
   double particle_steps_per_second;
-  Solver<2>::Memory memory;
+  SolverMemory memory;
   long particles;
 };
 
+// A block of `particles` (n x n per cell, n^Dim particles a cell) dropped on
+// a fixed floor between roller walls.
+template <int Dim>
 Measured measure(long particles, ShapeKind shape, Model model, int threads) {
   omp_set_num_threads(threads);
   const int per_cell = 2;
-  const int side = static_cast<int>(std::lround(std::sqrt(static_cast<double>(particles)) / per_cell));
+  const double per_side = std::pow(static_cast<double>(particles), 1.0 / Dim);
+  const int side = static_cast<int>(std::lround(per_side / per_cell));
   const double h = 1.0;
-  Grid<2> g;
+  Grid<Dim> g;
   g.h = h;
-  g.lower = {0, 0};
-  g.cells = {side * 2, side + 4};
-  g.upper = {g.cells[0] * h, g.cells[1] * h};
-  std::vector<Vec<2>> points;
-  fill_cells<2>(g, per_cell, Vec<2>(side / 2.0, 0), Vec<2>(side * 1.5, side), [](const Vec<2>&) { return true; }, points);
-  Particles<2> p;
-  const double volume = (h / per_cell) * (h / per_cell);
-  for (const auto& x : points) p.add(x, Vec<2>::Zero(), 1600 * volume, volume, 0.5 / per_cell, Mat<2>::Zero(), 0, 0);
+  g.lower = Vec<Dim>::Zero();
+  Vec<Dim> lo = Vec<Dim>::Zero(), hi;
+  for (int d = 0; d < Dim; ++d) {
+    // Twice the block's width across, room above it.
+    g.cells[d] = d == 1 ? side + 4 : side * 2;
+    lo[d] = d == 1 ? 0.0 : side / 2.0;
+    hi[d] = d == 1 ? side : side * 1.5;
+    g.upper[d] = g.cells[d] * h;
+  }
+  std::vector<Vec<Dim>> points;
+  fill_cells<Dim>(g, per_cell, lo, hi, [](const Vec<Dim>&) { return true; }, points);
+  Particles<Dim> p;
+  const double spacing = h / per_cell, volume = Dim == 2 ? spacing * spacing : spacing * spacing * spacing;
+  for (const auto& x : points)
+    p.add(x, Vec<Dim>::Zero(), 1600 * volume, volume, 0.5 / per_cell, Mat<Dim>::Zero(), 0, 0);
   const Elasticity e{1600, 6e7, 0.3};
-  std::vector<std::unique_ptr<Material<2>>> materials;
+  std::vector<std::unique_ptr<Material<Dim>>> materials;
   switch (model) {
-    case Model::elastic: materials.push_back(std::make_unique<LinearElastic<2>>("coal", e)); break;
+    case Model::elastic: materials.push_back(std::make_unique<LinearElastic<Dim>>("coal", e)); break;
     case Model::drucker_prager:
-      materials.push_back(std::make_unique<DruckerPrager<2>>("coal", e, 1e4, 0.5, 0.0, DruckerPragerFit::Kind::outer));
+      materials.push_back(
+          std::make_unique<DruckerPrager<Dim>>("coal", e, 1e4, 0.5, 0.0, DruckerPragerFit::Kind::outer));
       break;
     case Model::elastic_damage:
       // Weak enough that the block damages as it lands.
-      materials.push_back(std::make_unique<ElasticDamage<2>>("coal", e, DamageParameters{2e4, 0.5, 2e3, 0.1, 5, std::nullopt}));
+      materials.push_back(
+          std::make_unique<ElasticDamage<Dim>>("coal", e, DamageParameters{2e4, 0.5, 2e3, 0.1, 5, std::nullopt}));
       break;
   }
-  Settings<2> s;
+  Settings<Dim> s;
   s.shape = shape;
-  s.gravity = {0, -9.81};
-  s.walls = {Wall{Wall::Type::roller}, Wall{Wall::Type::roller}, Wall{Wall::Type::fixed}, Wall{}};
-  Solver<2> solver(g, std::move(materials), std::move(p), s);
+  s.gravity[1] = -9.81;
+  for (auto& w : s.walls) w = Wall{Wall::Type::roller};
+  s.walls[2] = Wall{Wall::Type::fixed};
+  s.walls[3] = Wall{};
+  Solver<Dim> solver(g, std::move(materials), std::move(p), s);
   const double dt = solver.stable_time_step();
   const long n = static_cast<long>(solver.particles().size());
   const int warmup = 3;
@@ -131,14 +146,15 @@ Measured measure(long particles, ShapeKind shape, Model model, int threads) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app("Particle-steps per second of the explicit MPM step (2D plane strain, 4 particles per cell), and "
-               "the memory per particle",
+  CLI::App app("Particle-steps per second of the explicit MPM step (2D plane strain, 4 particles per cell; or 3D, "
+               "8 per cell), and the memory per particle",
                "mpm-benchmark");
   std::vector<double> sizes{1e4, 1e5, 1e6};
   std::string csv_path;
   const int cores = omp_get_max_threads();
   std::vector<int> thread_counts{1, std::min(2, cores)};
   bool unloaded = false;
+  int dimension = 2;
   app.add_option("particles", sizes, "particles of each row's block (at least 100; 1e5 is read)")
       ->check(CLI::Range(100.0, 1e9))
       ->capture_default_str();
@@ -159,6 +175,10 @@ int main(int argc, char** argv) {
                  "thread counts measured (default 1 and 2, at most the cores); the speed-up column is the last "
                  "over the first")
       ->check(CLI::Range(1, 256));
+  app.add_option("--dimension", dimension,
+                 "2: plane strain (2 x 2 particles per cell); 3: 3D (2 x 2 x 2 per cell, a cube of them)")
+      ->check(CLI::IsMember({2, 3}))
+      ->capture_default_str();
   app.add_flag("--unloaded", unloaded,
                "one number: an elastic block spinning free of gravity and loads (B-splines, 1 thread, best of 5; "
                "scripts/unnamed-effects-benchmark.sh), of the first particle count (default 1e5)");
@@ -173,6 +193,10 @@ int main(int argc, char** argv) {
   for (const auto& name : shape_names) shapes.push_back(shape_words.at(name));
   for (const auto& name : model_names) models.push_back(model_words.at(name));
   if (unloaded) {
+    if (dimension != 2) {
+      std::fprintf(stderr, "mpm-benchmark: --unloaded measures the plane block; leave --dimension out\n");
+      return 2;
+    }
     const bool given = app.count("particles") > 0;
     std::printf("%.6e\n", unloaded_particle_steps_per_second(given ? std::lround(sizes.front()) : 100000));
     return 0;
@@ -192,7 +216,8 @@ int main(int argc, char** argv) {
     std::fprintf(csv, "particles,shape,material,one_thread,two_threads,speed_up,bytes_per_particle,"
                       "grid_bytes_per_particle\n");
   }
-  std::printf("particle-steps per second (2D plane strain, 4 particles per cell), %d cores\n\n", cores);
+  std::printf("particle-steps per second (%s), %d cores\n\n",
+              dimension == 2 ? "2D plane strain, 4 particles per cell" : "3D, 8 particles per cell", cores);
   // Memory per particle: the particles' own fields and per-step arrays, and
   // the grid's nodal arrays (with the last thread count's buffers) shared out over them.
   std::printf("%9s %-9s %-15s", "particles", "shape", "material");
@@ -203,7 +228,8 @@ int main(int argc, char** argv) {
       for (Model model : models) {
         const long n = std::lround(size);
         std::vector<Measured> rows;
-        for (int t : thread_counts) rows.push_back(measure(n, shape, model, t));
+        for (int t : thread_counts)
+          rows.push_back(dimension == 2 ? measure<2>(n, shape, model, t) : measure<3>(n, shape, model, t));
         const Measured& last = rows.back();
         const double count = static_cast<double>(last.particles);
         const double speed_up = last.particle_steps_per_second / rows.front().particle_steps_per_second;
