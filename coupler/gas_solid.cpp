@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include <Eigen/Eigenvalues>
 #include <fmt/format.h>
 
 #include "common/interval.hpp"
@@ -15,10 +16,21 @@ namespace {
   throw std::invalid_argument(fmt::format("{} has no field '{}'", who, field));
 }
 
-// The most compressive principal value of a 2D stress (tension positive).
-double smallest_principal(double xx, double yy, double xy) {
-  const double mean = 0.5 * (xx + yy), radius = std::hypot(0.5 * (xx - yy), xy);
-  return mean - radius;
+// The most compressive principal value of a cell's mean stress (tension
+// positive): in 2D of xx, yy, xy (the in-plane stresses the paper's law
+// reads), in 3D of xx, yy, zz, yz, xz, xy.
+template <int Dim>
+double smallest_principal(const double* s) {
+  if constexpr (Dim == 2) {
+    const double mean = 0.5 * (s[0] + s[1]), radius = std::hypot(0.5 * (s[0] - s[1]), s[2]);
+    return mean - radius;
+  } else {
+    Eigen::Matrix3d m;
+    m << s[0], s[5], s[4], s[5], s[1], s[3], s[4], s[3], s[2];
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+    solver.computeDirect(m, Eigen::EigenvaluesOnly);
+    return solver.eigenvalues()[0];
+  }
 }
 
 }  // namespace
@@ -31,12 +43,12 @@ double PermeabilityLaw::operator()(double lambda0, double compression, double da
 
 // ---- seepage
 
-SeepageParticipant::SeepageParticipant(seepage::Solver& solver, GasSolidSettings settings)
+template <int Dim>
+SeepageParticipant<Dim>::SeepageParticipant(seepage::SolverOf<Dim>& solver, GasSolidSettings settings)
     : solver_(solver), settings_(settings), lambda0_(solver.conductivity()) {
   const auto nc = static_cast<Eigen::Index>(solver_.mesh().num_cells());
   for (const auto& f : solid_fields)
-    received_[static_cast<std::size_t>(f.id)] =
-        Eigen::VectorXd::Constant(f.components * nc, f.start);
+    received_[static_cast<std::size_t>(f.id)] = Eigen::VectorXd::Constant(f.components_in(Dim) * nc, f.start);
   if (settings_.biot_storage && solver_.model().law != seepage::Law::linear)
     throw std::invalid_argument("seepage: Biot storage needs the linear Darcy law (law = \"linear\")");
   if (settings_.fixed_stress > 0) {
@@ -48,7 +60,8 @@ SeepageParticipant::SeepageParticipant(seepage::Solver& solver, GasSolidSettings
   solver_.set_open_nodes(std::vector<char>(solver_.mesh().num_nodes(), 0), settings_.open_pressure);
 }
 
-void SeepageParticipant::write(const std::string& field, const Eigen::VectorXd& values) {
+template <int Dim>
+void SeepageParticipant<Dim>::write(const std::string& field, const Eigen::VectorXd& values) {
   const auto f = std::find_if(solid_fields.begin(), solid_fields.end(), [&](const SolidFieldInfo& candidate) {
     return candidate.name == field && candidate.sent(settings_);
   });
@@ -60,7 +73,8 @@ void SeepageParticipant::write(const std::string& field, const Eigen::VectorXd& 
   target = values;
 }
 
-Eigen::VectorXd SeepageParticipant::read(const std::string& field) const {
+template <int Dim>
+Eigen::VectorXd SeepageParticipant<Dim>::read(const std::string& field) const {
   if (field != pressure_field) unknown_field(name(), field);
   const auto p = solver_.nodal_pressure();
   return Eigen::Map<const Eigen::VectorXd>(p.data(), static_cast<Eigen::Index>(p.size()));
@@ -68,7 +82,8 @@ Eigen::VectorXd SeepageParticipant::read(const std::string& field) const {
 
 // Cells the coal has left are open space, and so is every node touching one;
 // the rest get the permeability of their stress and damage.
-void SeepageParticipant::apply_solid_state() {
+template <int Dim>
+void SeepageParticipant<Dim>::apply_solid_state() {
   const auto& mesh = solver_.mesh();
   const std::size_t nc = mesh.num_cells();
   const auto& occupancy = received(SolidField::occupancy);
@@ -84,15 +99,17 @@ void SeepageParticipant::apply_solid_state() {
   solver_.set_open_nodes(open, settings_.open_pressure);
   if (!settings_.permeability_coupling) return;
   std::vector<double> lambda(nc);
+  const Eigen::Index k = solid_fields[static_cast<std::size_t>(SolidField::stress)].components_in(Dim);
   for (std::size_t c = 0; c < nc; ++c) {
     const auto i = static_cast<Eigen::Index>(c);
-    const double compression = -smallest_principal(stress[3 * i], stress[3 * i + 1], stress[3 * i + 2]);
+    const double compression = -smallest_principal<Dim>(&stress[k * i]);
     lambda[c] = settings_.permeability(lambda0_[c], compression, std::clamp(damage[i], 0.0, 1.0));
   }
   solver_.set_conductivity(lambda);
 }
 
-void SeepageParticipant::advance(double window) {
+template <int Dim>
+void SeepageParticipant<Dim>::advance(double window) {
   apply_solid_state();
   if (settings_.biot_storage) {
     // The rate over the solid's last window, which matched the seepage's last.
@@ -107,12 +124,14 @@ void SeepageParticipant::advance(double window) {
   last_size_ = window;
 }
 
-void SeepageParticipant::save_between_windows(checkpoint::Out out) const {
+template <int Dim>
+void SeepageParticipant<Dim>::save_between_windows(checkpoint::Out out) const {
   for (const auto& f : solid_fields) out.numbers(std::string(f.name), received(f.id));
   out.number("last_size", last_size_);
 }
 
-void SeepageParticipant::load_between_windows(const checkpoint::In& in) {
+template <int Dim>
+void SeepageParticipant<Dim>::load_between_windows(const checkpoint::In& in) {
   for (const auto& f : solid_fields) {
     auto& values = received_[static_cast<std::size_t>(f.id)];
     values = in.vector(std::string(f.name), static_cast<std::size_t>(values.size()));
@@ -120,13 +139,22 @@ void SeepageParticipant::load_between_windows(const checkpoint::In& in) {
   last_size_ = in.number("last_size");
 }
 
-void SeepageParticipant::save() { saved_ = solver_.save_state(); }
-void SeepageParticipant::restore() { solver_.restore_state(saved_); }
+template <int Dim>
+void SeepageParticipant<Dim>::save() {
+  saved_ = solver_.save_state();
+}
+
+template <int Dim>
+void SeepageParticipant<Dim>::restore() {
+  solver_.restore_state(saved_);
+}
 
 // ---- solid
 
-SolidParticipant::SolidParticipant(mpm::Solver<2>& solver, const MeshMapping& mapping, const GasSolidSettings& settings,
-                                   Eigen::VectorXd pressure, std::optional<double> fixed_time_step)
+template <int Dim>
+SolidParticipant<Dim>::SolidParticipant(mpm::Solver<Dim>& solver, const MeshMapping<Dim>& mapping,
+                                        const GasSolidSettings& settings, Eigen::VectorXd pressure,
+                                        std::optional<double> fixed_time_step)
     : solver_(solver),
       mapping_(mapping),
       biot_(settings.biot),
@@ -145,7 +173,8 @@ SolidParticipant::SolidParticipant(mpm::Solver<2>& solver, const MeshMapping& ma
   mark_window_start();
 }
 
-void SolidParticipant::mark_window_start() {
+template <int Dim>
+void SolidParticipant<Dim>::mark_window_start() {
   if (!sends_dilatation_) return;
   const auto& p = solver_.particles();
   const auto ids = std::max_element(p.id.begin(), p.id.end());
@@ -153,7 +182,8 @@ void SolidParticipant::mark_window_start() {
   for (std::size_t i = 0; i < p.size(); ++i) start_volume_[static_cast<std::size_t>(p.id[i])] = p.volume[i];
 }
 
-void SolidParticipant::make_initial_stress_effective(const std::vector<double>& cell_pressure) {
+template <int Dim>
+void SolidParticipant<Dim>::make_initial_stress_effective(const std::vector<double>& cell_pressure) {
   if (cell_pressure.size() != mapping_.mesh().num_cells())
     throw std::invalid_argument("solid: one initial pressure per seepage cell expected");
   const auto& p = solver_.particles();
@@ -164,7 +194,8 @@ void SolidParticipant::make_initial_stress_effective(const std::vector<double>& 
   averages_.reset();
 }
 
-void SolidParticipant::write(const std::string& field, const Eigen::VectorXd& values) {
+template <int Dim>
+void SolidParticipant<Dim>::write(const std::string& field, const Eigen::VectorXd& values) {
   if (field != pressure_field) unknown_field(name(), field);
   if (values.size() != pressure_end_.size())
     throw std::invalid_argument(fmt::format("solid: field 'pressure' has {} values, expected {}", values.size(),
@@ -172,11 +203,12 @@ void SolidParticipant::write(const std::string& field, const Eigen::VectorXd& va
   pressure_end_ = values;
 }
 
-void SolidParticipant::compute_averages() const {
+template <int Dim>
+void SolidParticipant<Dim>::compute_averages() const {
   if (averages_) return;
   const auto& p = solver_.particles();
   std::size_t k = 0;
-  for (const auto& f : averaged_) k += static_cast<std::size_t>(f.components);
+  for (const auto& f : averaged_) k += static_cast<std::size_t>(f.components_in(Dim));
   std::vector<double> values(k * p.size());
   // Fixed stress: the volume change less (alpha / K_dr) times the change of
   // the pressure felt, beta / alpha = alpha / K_dr.
@@ -185,11 +217,15 @@ void SolidParticipant::compute_averages() const {
     double* out = &values[k * i];
     for (const auto& f : averaged_) {
       switch (f.id) {
-        case SolidField::stress:
-          out[0] = p.stress[i](0, 0);
-          out[1] = p.stress[i](1, 1);
-          out[2] = p.stress[i](0, 1);
+        case SolidField::stress: {
+          const auto& s = p.stress[i];
+          if constexpr (Dim == 2) {
+            out[0] = s(0, 0), out[1] = s(1, 1), out[2] = s(0, 1);
+          } else {
+            out[0] = s(0, 0), out[1] = s(1, 1), out[2] = s(2, 2), out[3] = s(1, 2), out[4] = s(0, 2), out[5] = s(0, 1);
+          }
           break;
+        }
         case SolidField::damage: out[0] = p.damage.empty() ? 0.0 : p.damage[i]; break;
         case SolidField::dilatation:
           // Volume-weighted, this sums to the volume change over the window.
@@ -199,28 +235,30 @@ void SolidParticipant::compute_averages() const {
           break;
         case SolidField::occupancy: break;  // the fraction itself, not a mean
       }
-      out += f.components;
+      out += f.components_in(Dim);
     }
   }
   averages_ = mapping_.average(p.x, p.volume, values, static_cast<int>(k));
 }
 
-Eigen::VectorXd SolidParticipant::read(const std::string& field) const {
+template <int Dim>
+Eigen::VectorXd SolidParticipant<Dim>::read(const std::string& field) const {
   compute_averages();
   const auto& a = *averages_;
   const auto nc = static_cast<Eigen::Index>(a.fraction.size());
   const Eigen::Map<const Eigen::VectorXd> fraction(a.fraction.data(), nc);
   if (field == name_of(SolidField::occupancy)) return fraction;
   Eigen::Index row = 0, rows = 0;
-  for (const auto& f : averaged_) rows += f.components;
+  for (const auto& f : averaged_) rows += f.components_in(Dim);
   const Eigen::Map<const Eigen::MatrixXd> mean(a.mean.data(), rows, nc);
   for (const auto& f : averaged_) {
+    const int components = f.components_in(Dim);
     if (f.name != field) {
-      row += f.components;
+      row += components;
       continue;
     }
-    const Eigen::MatrixXd block = mean.middleRows(row, f.components);
-    const Eigen::Map<const Eigen::VectorXd> cellwise(block.data(), f.components * nc);
+    const Eigen::MatrixXd block = mean.middleRows(row, components);
+    const Eigen::Map<const Eigen::VectorXd> cellwise(block.data(), components * nc);
     // The dilatation is a volume change per cell area: the mean over the
     // solid times its fraction.
     if (f.id == SolidField::dilatation) return cellwise.cwiseProduct(fraction);
@@ -231,7 +269,8 @@ Eigen::VectorXd SolidParticipant::read(const std::string& field) const {
 
 // The gas force (-alpha grad(p) V_p, or alpha p in the total stress) with p
 // interpolated between the window's ends at `fraction` of it, or at its end.
-void SolidParticipant::set_gas_force(double fraction) {
+template <int Dim>
+void SolidParticipant<Dim>::set_gas_force(double fraction) {
   const auto& p = solver_.particles();
   if (window_pressure_ == stability::Pressure::end) fraction = 1;
   pressure_now_ = (1 - fraction) * pressure_start_ + fraction * pressure_end_;
@@ -251,11 +290,12 @@ void SolidParticipant::set_gas_force(double fraction) {
 #pragma omp parallel for schedule(static)
   for (int i = 0; i < n; ++i) {
     const auto s = mapping_.sample(pressure_now_, p.x[i], &cell_hint_[i]);
-    force[i] = s ? mpm::Vec<2>(-biot_ * p.volume[i] * s->gradient) : mpm::Vec<2>::Zero();
+    force[i] = s ? mpm::Vec<Dim>(-biot_ * p.volume[i] * s->gradient) : mpm::Vec<Dim>::Zero();
   }
 }
 
-void SolidParticipant::advance(double window) {
+template <int Dim>
+void SolidParticipant<Dim>::advance(double window) {
   mark_window_start();
   const double start = solver_.time(), end = start + window;
   last_window_ = {0};
@@ -273,14 +313,16 @@ void SolidParticipant::advance(double window) {
   averages_.reset();
 }
 
-void SolidParticipant::save_between_windows(checkpoint::Out out) const {
+template <int Dim>
+void SolidParticipant<Dim>::save_between_windows(checkpoint::Out out) const {
   out.numbers("pressure_start", pressure_start_);
   out.numbers("pressure_end", pressure_end_);
   out.numbers("felt_change", felt_change_);
   out.counts("cell_hint", cell_hint_);
 }
 
-void SolidParticipant::load_between_windows(const checkpoint::In& in) {
+template <int Dim>
+void SolidParticipant<Dim>::load_between_windows(const checkpoint::In& in) {
   const auto nodes = static_cast<std::size_t>(pressure_start_.size());
   pressure_start_ = in.vector("pressure_start", nodes);
   pressure_end_ = in.vector("pressure_end", nodes);
@@ -289,15 +331,22 @@ void SolidParticipant::load_between_windows(const checkpoint::In& in) {
   averages_.reset();
 }
 
-void SolidParticipant::save() {
+template <int Dim>
+void SolidParticipant<Dim>::save() {
   saved_ = solver_.save_state();
   saved_pressure_ = pressure_start_;
 }
 
-void SolidParticipant::restore() {
+template <int Dim>
+void SolidParticipant<Dim>::restore() {
   solver_.restore_state(saved_);
   pressure_start_ = saved_pressure_;
   averages_.reset();
 }
+
+template class SeepageParticipant<2>;
+template class SeepageParticipant<3>;
+template class SolidParticipant<2>;
+template class SolidParticipant<3>;
 
 }  // namespace outburst::coupling

@@ -14,7 +14,8 @@
 //     interpolates it linearly in time over the window, in space with the Q1
 //     shape functions, at every MPM step.
 //   solid -> seepage: per seepage cell, "occupancy" (solid volume fraction),
-//     "stress" (volume-averaged effective stress xx, yy, xy [Pa]) and "damage";
+//     "stress" (volume-averaged effective stress xx, yy, xy [Pa]; in 3D xx,
+//     yy, zz, yz, xz, xy) and "damage";
 //     with Biot storage also "dilatation": the particles' volume change over
 //     the window per cell area, which the seepage takes as the source
 //     -alpha dilatation / window (linear Darcy law). With the fixed-stress
@@ -86,7 +87,7 @@ enum class SolidField { occupancy, stress, damage, dilatation };
 struct SolidFieldInfo {
   SolidField id;
   std::string_view name;  // the coupling's and the checkpoint's
-  int components;         // values per seepage cell
+  std::array<int, 2> components;  // values per seepage cell, in 2D and in 3D
   double start;           // what the seepage holds before the solid first sends it
   // The [coupling] key of its absolute convergence floor (the scene reader
   // reads each floor key once).
@@ -94,14 +95,18 @@ struct SolidFieldInfo {
   // Whether a coupled run with these settings sends it (the scheme decides
   // whether anything is sent back at all: a one-way scheme sends nothing).
   bool (*sent)(const GasSolidSettings&);
+  int components_in(int dim) const { return components[static_cast<std::size_t>(dim - 2)]; }
 };
 inline constexpr std::string_view pressure_field = "pressure";  // nodal p [Pa]
 // In the order they stack.
 inline constexpr std::array<SolidFieldInfo, 4> solid_fields{{
-    {SolidField::occupancy, "occupancy", 1, 1.0, "fraction_floor", [](const GasSolidSettings&) { return true; }},
-    {SolidField::stress, "stress", 3, 0.0, "stress_floor", [](const GasSolidSettings& g) { return g.permeability_coupling; }},
-    {SolidField::damage, "damage", 1, 0.0, "fraction_floor", [](const GasSolidSettings& g) { return g.permeability_coupling; }},
-    {SolidField::dilatation, "dilatation", 1, 0.0, "dilatation_floor", [](const GasSolidSettings& g) { return g.biot_storage; }},
+    {SolidField::occupancy, "occupancy", {1, 1}, 1.0, "fraction_floor", [](const GasSolidSettings&) { return true; }},
+    {SolidField::stress, "stress", {3, 6}, 0.0, "stress_floor",
+     [](const GasSolidSettings& g) { return g.permeability_coupling; }},
+    {SolidField::damage, "damage", {1, 1}, 0.0, "fraction_floor",
+     [](const GasSolidSettings& g) { return g.permeability_coupling; }},
+    {SolidField::dilatation, "dilatation", {1, 1}, 0.0, "dilatation_floor",
+     [](const GasSolidSettings& g) { return g.biot_storage; }},
 }};
 constexpr std::string_view name_of(SolidField field) {
   for (const auto& f : solid_fields)
@@ -109,9 +114,10 @@ constexpr std::string_view name_of(SolidField field) {
   return {};
 }
 
+template <int Dim>
 class SeepageParticipant final : public Participant {
  public:
-  SeepageParticipant(seepage::Solver& solver, GasSolidSettings settings);
+  SeepageParticipant(seepage::SolverOf<Dim>& solver, GasSolidSettings settings);
   std::string name() const override { return "seepage"; }
   void write(const std::string& field, const Eigen::VectorXd& values) override;
   Eigen::VectorXd read(const std::string& field) const override;
@@ -132,7 +138,7 @@ class SeepageParticipant final : public Participant {
  private:
   void apply_solid_state();
 
-  seepage::Solver& solver_;
+  seepage::SolverOf<Dim>& solver_;
   GasSolidSettings settings_;
   std::vector<double> lambda0_;  // the scene's conductivity per cell
   // What the solid last sent, per field of solid_fields (unsent ones keep
@@ -143,18 +149,19 @@ class SeepageParticipant final : public Participant {
   // it last took, which had this size (the previous iterate of this window,
   // or the previous window in a one-pass scheme).
   double last_size_ = 0;
-  seepage::Solver::State saved_;
+  typename seepage::SolverOf<Dim>::State saved_;
   seepage::StepReport last_report_;
   int open_cells_ = 0;
 };
 
+template <int Dim>
 class SolidParticipant final : public Participant {
  public:
   // `pressure` is the nodal p [Pa] at the start (the seepage's initial state).
   // Of `settings` it uses alpha, the gas force's form, Biot storage
   // ("dilatation" is tracked and sent only with it), the fixed-stress split
   // and the window pressure.
-  SolidParticipant(mpm::Solver<2>& solver, const MeshMapping& mapping, const GasSolidSettings& settings,
+  SolidParticipant(mpm::Solver<Dim>& solver, const MeshMapping<Dim>& mapping, const GasSolidSettings& settings,
                    Eigen::VectorXd pressure, std::optional<double> fixed_time_step);
   std::string name() const override { return "solid"; }
   void write(const std::string& field, const Eigen::VectorXd& values) override;
@@ -183,8 +190,8 @@ class SolidParticipant final : public Participant {
   void compute_averages() const;
   void mark_window_start();
 
-  mpm::Solver<2>& solver_;
-  const MeshMapping& mapping_;
+  mpm::Solver<Dim>& solver_;
+  const MeshMapping<Dim>& mapping_;
   double biot_;
   GasForce force_;
   double fixed_stress_;  // beta [1/Pa]
@@ -199,9 +206,9 @@ class SolidParticipant final : public Participant {
   bool sends_dilatation_;
   std::vector<double> start_volume_;  // per particle id, at the window's start
   mpm::StepInfo last_window_{0};
-  mpm::Solver<2>::State saved_;
+  typename mpm::Solver<Dim>::State saved_;
   Eigen::VectorXd saved_pressure_;
-  mutable std::optional<MeshMapping::Averages> averages_;  // of the current state
+  mutable std::optional<typename MeshMapping<Dim>::Averages> averages_;  // of the current state
 };
 
 }  // namespace outburst::coupling

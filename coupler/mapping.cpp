@@ -2,9 +2,11 @@
 
 namespace outburst::coupling {
 
-MeshMapping::Averages MeshMapping::average(const std::vector<Eigen::Vector2d>& points,
-                                           const std::vector<double>& volume, const std::vector<double>& values,
-                                           int components) const {
+template <int Dim>
+typename MeshMapping<Dim>::Averages MeshMapping<Dim>::average(const std::vector<Point>& points,
+                                                              const std::vector<double>& volume,
+                                                              const std::vector<double>& values,
+                                                              int components) const {
   const std::size_t nc = mesh().num_cells(), k = static_cast<std::size_t>(components);
   Averages a{std::vector<double>(nc, 0.0), std::vector<double>(nc * k, 0.0)};
   for (std::size_t p = 0; p < points.size(); ++p) {
@@ -21,5 +23,8 @@ MeshMapping::Averages MeshMapping::average(const std::vector<Eigen::Vector2d>& p
   }
   return a;
 }
+
+template class MeshMapping<2>;
+template class MeshMapping<3>;
 
 }  // namespace outburst::coupling

@@ -1,6 +1,6 @@
 #pragma once
-// Data mapping between the seepage mesh (fixed Q1 quadrilaterals) and the
-// material points (moving, each with a volume):
+// Data mapping between the seepage mesh (fixed Q1 quadrilaterals, hexahedra in
+// 3D) and the material points (moving, each with a volume):
 //
 //   mesh -> points: a nodal field and its gradient at any point, by the Q1
 //     shape functions of the cell holding it (consistent: a linear field is
@@ -8,7 +8,7 @@
 //   points -> mesh: per cell, the solid volume fraction (sum of the volumes of
 //     the points in it over the cell's area) and volume-weighted averages
 //     (conservative: sum over cells of average x solid volume = sum over points
-//     of value x volume).
+//     of value x volume). In 2D areas and volumes are per metre of depth.
 //
 // A point outside the mesh maps to nothing (no gas force, no share in a cell).
 
@@ -21,22 +21,25 @@
 
 namespace outburst::coupling {
 
+template <int Dim>
 class MeshMapping {
  public:
+  using Point = Eigen::Matrix<double, Dim, 1>;
   // Reads the mesh through the seepage's sampler, which must outlive it.
-  explicit MeshMapping(const seepage::Sampler& sampler) : sampler_(sampler) {}
+  explicit MeshMapping(const seepage::SamplerOf<Dim>& sampler) : sampler_(sampler) {}
 
-  const seepage::Mesh& mesh() const { return sampler_.mesh(); }
+  const seepage::MeshOf<Dim>& mesh() const { return sampler_.mesh(); }
+  // Each cell's area (volume in 3D).
   const std::vector<double>& cell_area() const { return sampler_.cell_area(); }
 
-  using Sample = seepage::Sampler::Value;
+  using Sample = typename seepage::SamplerOf<Dim>::Value;
   // Nodal field and its gradient at x; nullopt outside the mesh. `hint`: the
   // cell to try first, updated (see seepage::Sampler::sample).
-  std::optional<Sample> sample(const Eigen::VectorXd& nodal, const Eigen::Vector2d& x, int* hint = nullptr) const {
+  std::optional<Sample> sample(const Eigen::VectorXd& nodal, const Point& x, int* hint = nullptr) const {
     return sampler_.sample(nodal, x, hint);
   }
   // The cell holding x, or -1.
-  int cell_of(const Eigen::Vector2d& x) const { return sampler_.cell_of(x); }
+  int cell_of(const Point& x) const { return sampler_.cell_of(x); }
 
   // Volume-weighted cell averages of `components` values per point
   // (values[p * components + k]); cells without points get 0. Also returns the
@@ -45,11 +48,11 @@ class MeshMapping {
     std::vector<double> fraction;  // solid volume / cell area
     std::vector<double> mean;      // per cell, `components` values
   };
-  Averages average(const std::vector<Eigen::Vector2d>& points, const std::vector<double>& volume,
+  Averages average(const std::vector<Point>& points, const std::vector<double>& volume,
                    const std::vector<double>& values, int components) const;
 
  private:
-  const seepage::Sampler& sampler_;
+  const seepage::SamplerOf<Dim>& sampler_;
 };
 
 }  // namespace outburst::coupling

@@ -197,7 +197,7 @@ CoupledModel::CoupledModel(CoupledSetup setup, bool settle_later) : setup_(std::
   seepage_ = std::make_unique<seepage::Solver>(std::move(seep.mesh), seep.model, seep.settings);
   solid_ = std::make_unique<mpm::Solver<2>>(solid.grid, std::move(solid.materials), std::move(solid.particles),
                                          solid.settings);
-  mapping_ = std::make_unique<MeshMapping>(seepage_->sampler());
+  mapping_ = std::make_unique<MeshMapping<2>>(seepage_->sampler());
   GasSolidSettings gas_solid = cs.gas_solid;
   if (cs.fixed_stress_split.value_or(false)) {
     // The softest coal's drained bulk modulus: the split's stabilisation must
@@ -211,8 +211,8 @@ CoupledModel::CoupledModel(CoupledSetup setup, bool settle_later) : setup_(std::
     gas_solid.fixed_stress = gas_solid.biot * gas_solid.biot / bulk;
   }
   gas_solid.window_pressure = cs.window_pressure.value_or(stability::Pressure::ramp);
-  seepage_side_ = std::make_unique<SeepageParticipant>(*seepage_, gas_solid);
-  solid_side_ = std::make_unique<SolidParticipant>(*solid_, *mapping_, gas_solid, seepage_side_->read(std::string(pressure_field)),
+  seepage_side_ = std::make_unique<SeepageParticipant<2>>(*seepage_, gas_solid);
+  solid_side_ = std::make_unique<SolidParticipant<2>>(*solid_, *mapping_, gas_solid, seepage_side_->read(std::string(pressure_field)),
                                                    solid.fixed_time_step);
   if (cs.total_initial_stress) {
     std::vector<double> cell_pressure;

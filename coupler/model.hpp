@@ -58,9 +58,9 @@ class CoupledModel {
   const CouplingSetup& coupling_setup() const { return setup_.coupling; }
   seepage::Solver& seepage() { return *seepage_; }
   mpm::Solver<2>& solid() { return *solid_; }
-  const MeshMapping& mapping() const { return *mapping_; }
-  const SeepageParticipant& seepage_side() const { return *seepage_side_; }
-  const SolidParticipant& solid_side() const { return *solid_side_; }
+  const MeshMapping<2>& mapping() const { return *mapping_; }
+  const SeepageParticipant<2>& seepage_side() const { return *seepage_side_; }
+  const SolidParticipant<2>& solid_side() const { return *solid_side_; }
   const Coupling& coupling() const { return *coupling_; }
   // Both solvers, both participants and the coupling, to and from a
   // checkpoint taken between windows.
@@ -74,9 +74,9 @@ class CoupledModel {
   CoupledSetup setup_;
   std::unique_ptr<seepage::Solver> seepage_;
   std::unique_ptr<mpm::Solver<2>> solid_;
-  std::unique_ptr<MeshMapping> mapping_;
-  std::unique_ptr<SeepageParticipant> seepage_side_;
-  std::unique_ptr<SolidParticipant> solid_side_;
+  std::unique_ptr<MeshMapping<2>> mapping_;
+  std::unique_ptr<SeepageParticipant<2>> seepage_side_;
+  std::unique_ptr<SolidParticipant<2>> solid_side_;
   std::unique_ptr<Coupling> coupling_;
   std::optional<double> settled_;
 };
