@@ -36,6 +36,23 @@ inline seepage::Solver rectangle_solver(seepage::Law law, Eigen::Vector2d size, 
   return seepage::Solver(std::move(p.mesh), std::move(p.model), settings);
 }
 
+// One region on a generated box; `conditions` name left/right, bottom/top,
+// back/front.
+inline seepage::Solver3 box_solver(seepage::Law law, Eigen::Vector3d size, std::array<int, 3> cells,
+                                   seepage::Material material, std::vector<seepage::BoundaryCondition> conditions,
+                                   seepage::Settings settings = {},
+                                   std::array<double, 3> grading = {1.0, 1.0, 1.0}) {
+  seepage::BoxMeshSpec spec;
+  spec.size = size;
+  spec.cells = cells;
+  spec.grading = grading;
+  seepage::Model model;
+  model.law = law;
+  model.materials = {material};
+  model.boundary_conditions = std::move(conditions);
+  return seepage::Solver3(seepage::make_box_mesh(spec), model, settings);
+}
+
 inline seepage::BoundaryCondition fixed_pressure(const std::string& boundary, double p) {
   return {boundary, seepage::BoundaryCondition::Type::pressure, TimeFunction(p)};
 }

@@ -17,20 +17,6 @@ using namespace outburst::testing;
 
 namespace {
 
-seepage::Solver3 box_solver(seepage::Law law, Eigen::Vector3d size, std::array<int, 3> cells,
-                            seepage::Material material, std::vector<seepage::BoundaryCondition> conditions,
-                            seepage::Settings settings = {}, std::array<double, 3> grading = {1.0, 1.0, 1.0}) {
-  seepage::BoxMeshSpec spec;
-  spec.size = size;
-  spec.cells = cells;
-  spec.grading = grading;
-  seepage::Model model;
-  model.law = law;
-  model.materials = {material};
-  model.boundary_conditions = std::move(conditions);
-  return seepage::Solver3(seepage::make_box_mesh(spec), model, settings);
-}
-
 // A 3 x 3 x 3 box whose interior nodes are moved off the lattice: its cells
 // are not parallelepipeds.
 seepage::Mesh3 distorted_box() {

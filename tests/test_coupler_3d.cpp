@@ -1,0 +1,153 @@
+// The gas-solid coupling in 3D: the mapping between hexahedra and particles,
+// and a column driven one way by a prescribed gas pressure against the
+// analytic answer, as tests/test_coupler_gas_solid.cpp checks the plane ones.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <random>
+
+#include "coupler/gas_solid.hpp"
+#include "mpm_fixtures.hpp"
+#include "seepage_fixtures.hpp"
+
+using namespace outburst;
+using namespace outburst::coupling;
+using namespace outburst::testing;
+
+TEST_CASE("3D: hexahedra to points reproduce a linear field and its gradient exactly", "[coupler][mapping][3d]") {
+  const Eigen::Vector3d b(-2.0, 0.7, 1.3);
+  const double a = 3.0;
+  auto seep = box_solver(seepage::Law::linear, {4, 2, 3}, {5, 3, 4}, {1e-9, 1e-9, 1e6}, {}, {}, {2.0, 0.5, 1.5});
+  const MeshMapping map(seep.sampler());
+  Eigen::VectorXd nodal(static_cast<Eigen::Index>(map.mesh().num_nodes()));
+  for (std::size_t i = 0; i < map.mesh().num_nodes(); ++i)
+    nodal[static_cast<Eigen::Index>(i)] = a + b.dot(map.mesh().nodes[i]);
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> u(0, 1);
+  double worst_value = 0, worst_gradient = 0;
+  int found = 0;
+  for (int k = 0; k < 2000; ++k) {
+    const Eigen::Vector3d x(4.4 * u(random) - 0.2, 2 * u(random), 3 * u(random));  // some outside
+    const auto s = map.sample(nodal, x);
+    if (!s) {
+      CHECK((x.x() < 0 || x.x() > 4));
+      continue;
+    }
+    ++found;
+    worst_value = std::max(worst_value, std::abs(s->value - (a + b.dot(x))));
+    worst_gradient = std::max(worst_gradient, (s->gradient - b).norm());
+  }
+  std::printf("\nlinear field on a graded box of hexahedra: %d points, worst value error %.2e, gradient error %.2e\n",
+              found, worst_value, worst_gradient);
+  CHECK(found > 1500);
+  CHECK(worst_value < 1e-12);
+  CHECK(worst_gradient < 1e-11);
+}
+
+TEST_CASE("3D: points to hexahedra: volume fractions and averages conserve what they average",
+          "[coupler][mapping][3d]") {
+  auto seep = box_solver(seepage::Law::linear, {4, 2, 1}, {8, 4, 3}, {1e-9, 1e-9, 1e6}, {}, {}, {2.0, 1.0, 0.5});
+  const MeshMapping map(seep.sampler());
+  std::mt19937 random(3);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<Eigen::Vector3d> x;
+  std::vector<double> volume, values;
+  double total_volume = 0, total_first = 0, total_second = 0;
+  for (int k = 0; k < 5000; ++k) {
+    x.emplace_back(4.4 * u(random) - 0.2, 2 * u(random), u(random));  // some outside the mesh
+    volume.push_back(1e-4 * (1 + u(random)));
+    values.push_back(u(random));
+    values.push_back(-5 * u(random));
+    if (x.back().x() >= 0 && x.back().x() <= 4) {
+      total_volume += volume.back();
+      total_first += volume.back() * values[values.size() - 2];
+      total_second += volume.back() * values.back();
+    }
+  }
+  const auto avg = map.average(x, volume, values, 2);
+  double mapped_volume = 0, mapped_first = 0, mapped_second = 0, cells = 0;
+  for (std::size_t c = 0; c < map.mesh().num_cells(); ++c) {
+    const double solid = avg.fraction[c] * map.cell_area()[c];
+    cells += map.cell_area()[c];
+    mapped_volume += solid;
+    mapped_first += solid * avg.mean[2 * c];
+    mapped_second += solid * avg.mean[2 * c + 1];
+  }
+  CHECK(cells == Approx(8.0).epsilon(1e-12));
+  CHECK(mapped_volume == Approx(total_volume).epsilon(1e-12));
+  CHECK(mapped_first == Approx(total_first).epsilon(1e-12));
+  CHECK(mapped_second == Approx(total_second).epsilon(1e-12));
+}
+
+TEST_CASE("3D one-way: a column under a linear gas pressure settles to the analytic displacement and effective "
+          "stress",
+          "[coupler][one_way][3d]") {
+  // p = p0 (1 - y / H): the gas pushes the column up with alpha p0 / H per
+  // volume; the bottom is fixed, the sides are rollers and the top is free,
+  // so sigma'_yy = f (H - y) (tension) and u_y = f / M (H y - y^2 / 2), M
+  // the constrained modulus; sigma'_xx = sigma'_zz = nu / (1 - nu) sigma'_yy.
+  const double H = 10, p0 = 3e6, alpha = 0.5, E = 1e9, nu = 0.25, rho = 1500;
+  auto seep = box_solver(seepage::Law::linear, {1, H, 1}, {2, 20, 2}, {1e-9, 1e-9, p0},
+                         {fixed_pressure("bottom", p0), fixed_pressure("top", 0)});
+  std::vector<double> linear(seep.mesh().num_nodes());
+  for (std::size_t i = 0; i < linear.size(); ++i) linear[i] = p0 * (1 - seep.mesh().nodes[i].y() / H);
+  seep.set_initial_pressure(linear);
+
+  const mpm::Grid<3> gr = grid(mpm::Vec<3>(1.0, 11.0, 1.0), 0.25);
+  mpm::Settings<3> s;
+  s.local_damping = 0.7;
+  for (auto& w : s.walls) w = mpm::Wall{mpm::Wall::Type::roller};
+  s.walls[2] = mpm::Wall{mpm::Wall::Type::fixed};
+  s.walls[3] = mpm::Wall{};
+  mpm::Solver<3> solid(gr, elastic<3>({rho, E, nu}), block<3>(gr, mpm::Vec<3>::Zero(), mpm::Vec<3>(1, H, 1), rho, 2),
+                       s);
+
+  GasSolidSettings gs;
+  gs.biot = alpha;
+  gs.permeability_coupling = false;
+  SeepageParticipant seepage_side(seep, gs);
+  const MeshMapping map(seep.sampler());
+  SolidParticipant solid_side(solid, map, gs, seepage_side.read("pressure"), std::nullopt);
+  SchemeSettings scheme;
+  scheme.kind = SchemeSettings::Kind::one_way;
+  scheme.to_second = {"pressure"};
+  Coupling c(seepage_side, solid_side, scheme);
+  while (c.time() < 0.5) c.advance(0.005);
+
+  const double f = alpha * p0 / H, M = E * (1 - nu) / ((1 + nu) * (1 - 2 * nu));
+  const auto& p = solid.particles();
+  double stress_error = 0, lateral_error = 0, displacement_error = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const double y = p.x0[i].y(), exact = f * (H - y);
+    stress_error = std::max(stress_error, std::abs(p.stress[i](1, 1) - exact));
+    const double k0 = nu / (1 - nu);
+    lateral_error = std::max(
+        {lateral_error, std::abs(p.stress[i](0, 0) - k0 * exact), std::abs(p.stress[i](2, 2) - k0 * exact)});
+    displacement_error = std::max(displacement_error, std::abs(p.x[i].y() - y - f / M * (H * y - y * y / 2)));
+  }
+  const double top_u = f / M * H * H / 2;
+  std::printf("\n3D one-way column: worst |sigma'_yy - f (H - y)| / (f H) = %.2e, lateral %.2e, worst displacement "
+              "error / u_top = %.2e (u_top = %.3g mm)\n",
+              stress_error / (f * H), lateral_error / (f * H), displacement_error / top_u, 1e3 * top_u);
+  CHECK(stress_error < 0.03 * f * H);
+  CHECK(lateral_error < 0.03 * f * H);
+  CHECK(displacement_error < 0.01 * top_u);
+  // With the permeability coupling the solid sends its cells' mean stress,
+  // six components (xx, yy, zz, yz, xz, xy), which conserve sum V sigma.
+  GasSolidSettings with_stress = gs;
+  with_stress.permeability_coupling = true;
+  const SolidParticipant probe(solid, map, with_stress, seepage_side.read("pressure"), std::nullopt);
+  const Eigen::VectorXd mean = probe.read("stress"), fraction = probe.read("occupancy");
+  const auto nc = static_cast<Eigen::Index>(seep.mesh().num_cells());
+  REQUIRE(mean.size() == 6 * nc);
+  Eigen::Matrix<double, 6, 1> mapped = Eigen::Matrix<double, 6, 1>::Zero(), direct = mapped;
+  for (Eigen::Index cell = 0; cell < nc; ++cell)
+    mapped += fraction[cell] * map.cell_area()[static_cast<std::size_t>(cell)] * mean.segment<6>(6 * cell);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const auto& t = p.stress[i];
+    if (map.cell_of(p.x[i]) < 0) continue;
+    direct += p.volume[i] * (Eigen::Matrix<double, 6, 1>() << t(0, 0), t(1, 1), t(2, 2), t(1, 2), t(0, 2), t(0, 1))
+                                .finished();
+  }
+  CHECK((mapped - direct).norm() < 1e-12 * direct.norm());
+}
