@@ -14,7 +14,7 @@ Output::Output(const std::filesystem::path& directory, const output::RunInfo& in
   for (const auto& p : mesh.nodes) xyz.insert(xyz.end(), {p.x(), p.y(), 0.0});
   std::vector<std::int64_t> quads;
   for (const auto& c : mesh.cells) quads.insert(quads.end(), c.begin(), c.end());
-  series_.add_quad_mesh("mesh", xyz, quads);
+  series_.add_mesh("mesh", xyz, quads, output::CellShape::quadrilateral);
 
   if (resume) return;
   history_.open(history_path_, std::ios::trunc);
