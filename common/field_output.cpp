@@ -61,14 +61,17 @@ FieldSeries::FieldSeries(std::filesystem::path directory, std::string name, RunI
   std::filesystem::create_directories(directory_);
 }
 
-void FieldSeries::add_quad_mesh(const std::string& grid, const std::vector<double>& xyz,
-                                const std::vector<std::int64_t>& quads) {
+int corners_of(CellShape shape) { return shape == CellShape::quadrilateral ? 4 : 8; }
+
+void FieldSeries::add_mesh(const std::string& grid, const std::vector<double>& xyz,
+                           const std::vector<std::int64_t>& cells, CellShape shape) {
+  const std::size_t corners = static_cast<std::size_t>(corners_of(shape));
   hdf5::H5Writer w(directory_ / (name_ + "_" + grid + ".h5"));
   w.write("/nodes", xyz.data(), {xyz.size() / 3, 3}, "m");
-  w.write("/cells", quads.data(), {quads.size() / 4, 4});
+  w.write("/cells", cells.data(), {cells.size() / corners, corners});
   stamp_provenance(w, info_);
   w.commit();
-  meshes_[grid] = {xyz.size() / 3, quads.size() / 4};
+  meshes_[grid] = {xyz.size() / 3, cells.size() / corners, shape};
 }
 
 void FieldSeries::add_point_grid(const std::string& grid) { point_grids_.push_back(grid); }
@@ -202,9 +205,11 @@ std::string FieldSeries::index_text() const {
         const std::string mesh_file = name_ + "_" + grid + ".h5";
         nodes = mesh->second.nodes;
         cells = mesh->second.cells;
-        x += fmt::format("<Topology TopologyType=\"Quadrilateral\" NumberOfElements=\"{}\">\n{}\n"
+        const CellShape shape = mesh->second.shape;
+        x += fmt::format("<Topology TopologyType=\"{}\" NumberOfElements=\"{}\">\n{}\n"
                          "</Topology>\n",
-                         cells, data_item(mesh_file, "/cells", cells, 4, true));
+                         shape == CellShape::quadrilateral ? "Quadrilateral" : "Hexahedron", cells,
+                         data_item(mesh_file, "/cells", cells, corners_of(shape), true));
         x += fmt::format("<Geometry GeometryType=\"XYZ\">\n{}\n</Geometry>\n",
                          data_item(mesh_file, "/nodes", nodes, 3, false));
       } else {

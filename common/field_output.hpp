@@ -34,6 +34,12 @@ struct RunInfo {
 
 enum class Center { node, cell };
 
+// The cells of a fixed mesh, with their corners in XDMF's (VTK's) order:
+// quadrilaterals counter-clockwise, hexahedra one face counter-clockwise seen
+// from the inside, then the opposite face in the same order (Gmsh's order too).
+enum class CellShape { quadrilateral, hexahedron };
+int corners_of(CellShape shape);
+
 struct Field {
   std::string name;
   Center center;
@@ -65,10 +71,10 @@ class FieldSeries {
  public:
   FieldSeries(std::filesystem::path directory, std::string name, RunInfo info);
 
-  // A fixed quadrilateral mesh: xyz holds 3 coordinates per node, quads 4 node
-  // indices per cell (counter-clockwise).
-  void add_quad_mesh(const std::string& grid, const std::vector<double>& xyz,
-                     const std::vector<std::int64_t>& quads);
+  // A fixed mesh of one cell shape: xyz holds 3 coordinates per node, cells
+  // corners_of(shape) node indices per cell.
+  void add_mesh(const std::string& grid, const std::vector<double>& xyz, const std::vector<std::int64_t>& cells,
+                CellShape shape);
   // A point cloud whose positions come with each snapshot.
   void add_point_grid(const std::string& grid);
 
@@ -96,6 +102,7 @@ class FieldSeries {
  private:
   struct MeshGrid {
     std::size_t nodes = 0, cells = 0;
+    CellShape shape = CellShape::quadrilateral;
   };
   struct WrittenField {
     std::string name;

@@ -6,11 +6,13 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <unordered_map>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "seepage_fe/q1.hpp"
 
@@ -56,6 +58,23 @@ std::vector<double> graded_coordinates(double start, double length, int n, doubl
   return x;
 }
 
+// The last region whose box holds the cell centre.
+template <int Dim>
+int region_holding(const std::vector<RegionBoxOf<Dim>>& regions, const Eigen::Matrix<double, Dim, 1>& centre) {
+  int region = -1;
+  for (std::size_t r = 0; r < regions.size(); ++r) {
+    const auto& reg = regions[r];
+    if (reg.whole_domain ||
+        ((centre.array() >= reg.box_min.array()).all() && (centre.array() <= reg.box_max.array()).all()))
+      region = static_cast<int>(r);
+  }
+  if (region < 0)
+    throw std::invalid_argument(fmt::format("the cell centred at ({:g} m) lies in no region's box; give one region "
+                                            "without a box to cover the whole mesh, or widen the boxes",
+                                            fmt::join(centre.data(), centre.data() + Dim, " m, ")));
+  return region;
+}
+
 }  // namespace
 
 Mesh make_structured_mesh(const StructuredMeshSpec& spec) {
@@ -71,18 +90,7 @@ Mesh make_structured_mesh(const StructuredMeshSpec& spec) {
     for (int i = 0; i < nx; ++i) {
       mesh.cells.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)});
       const Eigen::Vector2d centre(0.5 * (xs[i] + xs[i + 1]), 0.5 * (ys[j] + ys[j + 1]));
-      int region = -1;
-      for (std::size_t r = 0; r < spec.regions.size(); ++r) {
-        const auto& reg = spec.regions[r];
-        if (reg.whole_domain || ((centre.array() >= reg.box_min.array()).all() &&
-                                 (centre.array() <= reg.box_max.array()).all()))
-          region = static_cast<int>(r);
-      }
-      if (region < 0)
-        throw std::invalid_argument(fmt::format(
-            "the cell centred at ({:g} m, {:g} m) lies in no region's box; give one region "
-            "without a box to cover the whole mesh, or widen the boxes",
-            centre.x(), centre.y()));
+      const int region = region_holding(spec.regions, centre);
       mesh.cell_region.push_back(region);
     }
   }
@@ -111,8 +119,9 @@ class MshReader {
     if (error) throw std::runtime_error(fmt::format("{}: cannot read the mesh file's size", file.string()));
   }
 
-  [[noreturn]] void fail(const std::string& what) const {
-    throw std::runtime_error(fmt::format("{}:{}: {}", file_.string(), line_, what));
+  [[noreturn]] void fail(const std::string& what) const { fail_at(line_, what); }
+  [[noreturn]] void fail_at(int line, const std::string& what) const {
+    throw std::runtime_error(fmt::format("{}:{}: {}", file_.string(), line, what));
   }
 
   bool next_line(std::string& line) {
@@ -186,40 +195,66 @@ class MshReader {
   int line_ = 0;
 };
 
-const char* element_name(long type) {
+// Plural, as in "surface 3 holds 3-node triangles".
+std::string element_names(long type) {
   switch (type) {
-    case 1: return "2-node line";
-    case 2: return "3-node triangle";
-    case 3: return "4-node quadrangle";
-    case 8: return "3-node line";
-    case 9: return "6-node triangle";
-    case 10: return "9-node quadrangle";
-    case 15: return "point";
-    case 16: return "8-node quadrangle";
-    default: return "element";
+    case 1: return "2-node lines";
+    case 2: return "3-node triangles";
+    case 3: return "4-node quadrangles";
+    case 4: return "4-node tetrahedra";
+    case 5: return "8-node hexahedra";
+    case 6: return "6-node prisms";
+    case 7: return "5-node pyramids";
+    case 8: return "3-node lines";
+    case 9: return "6-node triangles";
+    case 10: return "9-node quadrangles";
+    case 11: return "10-node tetrahedra";
+    case 12: return "27-node hexahedra";
+    case 15: return "points";
+    case 16: return "8-node quadrangles";
+    case 17: return "20-node hexahedra";
+    default: return fmt::format("elements of type {}", type);
   }
 }
 
-}  // namespace
+// Gmsh's Q1 element of entity dimension d = 1, 2, 3 (at d - 1: the line,
+// the quadrangle, the hexahedron), its node count and how a record of it reads.
+constexpr long q1_type[3] = {1, 3, 5};
+constexpr int q1_nodes[3] = {2, 4, 8};
+constexpr const char* q1_record[3] = {"a line 'tag n1 n2'", "a quadrangle 'tag n1 n2 n3 n4'",
+                                      "a hexahedron 'tag n1 ... n8'"};
 
-Mesh read_gmsh(const std::filesystem::path& file, double length_scale) {
-  MshReader r(file);
+// One block of $Elements. Whether the file holds hexahedra decides what its
+// blocks are (cells or boundaries), so they are judged once all are read.
+struct ElementBlock {
+  int dim, entity;
+  long type;
+  long count;
+  int line;      // of the block's header
+  int physical;  // the entity's physical tag; -1: none
+  // The node tags of its elements (q1_nodes[dim - 1] each) and the line of each:
+  // kept for Q1 elements of physical entities only, the others are never used.
+  std::vector<long> tags;
+  std::vector<int> lines;
+};
+
+struct GmshFile {
   std::map<std::pair<int, int>, std::string> physical_names;  // (dim, tag) -> name
-  std::map<std::pair<int, int>, int> entity_physical;         // (dim, entity) -> physical tag
-  std::unordered_map<long, Eigen::Vector2d> node_xy;
-  struct RawCell {
-    std::array<long, 4> tags;
-    int physical;
-    int line;
-  };
-  struct RawEdge {
-    std::array<long, 2> tags;
-    int physical;
-  };
-  std::vector<RawCell> raw_cells;
-  std::vector<RawEdge> raw_edges;
-  bool seen_format = false, seen_nodes = false, seen_elements = false;
+  std::unordered_map<long, Eigen::Vector3d> nodes;            // tag -> x y z [m]
+  std::vector<ElementBlock> blocks;
+  bool has_hexahedra() const {
+    return std::any_of(blocks.begin(), blocks.end(), [](const ElementBlock& b) { return b.dim == 3 && b.count > 0; });
+  }
+  std::string physical_name(int dim, int tag) const {
+    const auto name = physical_names.find({dim, tag});
+    return name != physical_names.end() ? name->second : fmt::format("{}", tag);
+  }
+};
 
+GmshFile parse_gmsh(MshReader& r, double length_scale) {
+  GmshFile g;
+  std::map<std::pair<int, int>, int> entity_physical;  // (dim, entity) -> physical tag
+  bool seen_format = false, seen_nodes = false, seen_elements = false;
   std::string line;
   while (r.next_line(line)) {
     if (line.empty()) continue;
@@ -240,9 +275,8 @@ Mesh read_gmsh(const std::filesystem::path& file, double length_scale) {
         r.expect_count(t, 3, "a physical name 'dimension tag \"name\"'");
         std::string name = t[2];
         for (std::size_t k = 3; k < t.size(); ++k) name += " " + t[k];
-        if (name.size() >= 2 && name.front() == '"' && name.back() == '"')
-          name = name.substr(1, name.size() - 2);
-        physical_names[{r.integer<int>(t[0], "a dimension"), r.integer<int>(t[1], "a physical tag")}] = name;
+        if (name.size() >= 2 && name.front() == '"' && name.back() == '"') name = name.substr(1, name.size() - 2);
+        g.physical_names[{r.integer<int>(t[0], "a dimension"), r.integer<int>(t[1], "a physical tag")}] = name;
       }
       r.expect_end("$EndPhysicalNames");
     } else if (line == "$Entities") {
@@ -280,7 +314,8 @@ Mesh read_gmsh(const std::filesystem::path& file, double length_scale) {
         for (long i = 0; i < n; ++i) {
           const auto c = r.tokens("node coordinates 'x y z'");
           r.expect_count(c, 3, "node coordinates 'x y z'");
-          node_xy[tags[i]] = Eigen::Vector2d(r.number(c[0], "x"), r.number(c[1], "y")) * length_scale;
+          g.nodes[tags[i]] =
+              Eigen::Vector3d(r.number(c[0], "x"), r.number(c[1], "y"), r.number(c[2], "z")) * length_scale;
         }
       }
       r.expect_end("$EndNodes");
@@ -292,35 +327,22 @@ Mesh read_gmsh(const std::filesystem::path& file, double length_scale) {
       for (long b = 0; b < blocks; ++b) {
         const auto bh = r.tokens("an element block header");
         r.expect_count(bh, 4, "'entityDim entityTag elementType numElementsInBlock'");
-        const int dim = r.integer<int>(bh[0], "an entity dimension");
-        const int entity = r.integer<int>(bh[1], "an entity tag");
-        const long type = r.integer(bh[2], "an element type");
-        const long n = r.count(bh[3], "the number of elements in the block");
-        const auto phys = entity_physical.find({dim, entity});
-        if (dim == 2 && type != 3)
-          r.fail(fmt::format("surface {} holds {}s; the seepage solver needs 4-node "
-                             "quadrangles (add 'Recombine Surface{{...}};' to the .geo file)",
-                             entity, element_name(type)));
-        if (dim == 2 && phys == entity_physical.end())
-          r.fail(fmt::format("surface {} belongs to no physical group, so its cells would have "
-                             "no region; add it to a 'Physical Surface'",
-                             entity));
-        for (long i = 0; i < n; ++i) {
+        ElementBlock block{r.integer<int>(bh[0], "an entity dimension"), r.integer<int>(bh[1], "an entity tag"),
+                           r.integer(bh[2], "an element type"), r.count(bh[3], "the number of elements in the block"),
+                           r.line(), -1, {}, {}};
+        if (const auto p = entity_physical.find({block.dim, block.entity}); p != entity_physical.end())
+          block.physical = p->second;
+        const bool kept =
+            block.dim >= 1 && block.dim <= 3 && block.type == q1_type[block.dim - 1] && block.physical >= 0;
+        for (long i = 0; i < block.count; ++i) {
           const auto t = r.tokens("an element record");
-          if (dim == 2) {
-            r.expect_count(t, 5, "a quadrangle 'tag n1 n2 n3 n4'");
-            raw_cells.push_back({{r.integer(t[1], "a node tag"), r.integer(t[2], "a node tag"),
-                                  r.integer(t[3], "a node tag"), r.integer(t[4], "a node tag")},
-                                 phys->second, r.line()});
-          } else if (dim == 1 && phys != entity_physical.end()) {
-            if (type != 1)
-              r.fail(fmt::format("curve {} holds {}s; only 2-node lines are supported", entity,
-                                 element_name(type)));
-            r.expect_count(t, 3, "a line 'tag n1 n2'");
-            raw_edges.push_back(
-                {{r.integer(t[1], "a node tag"), r.integer(t[2], "a node tag")}, phys->second});
-          }
+          if (!kept) continue;
+          const int nodes = q1_nodes[block.dim - 1];
+          r.expect_count(t, static_cast<std::size_t>(nodes) + 1, q1_record[block.dim - 1]);
+          for (int k = 1; k <= nodes; ++k) block.tags.push_back(r.integer(t[k], "a node tag"));
+          block.lines.push_back(r.line());
         }
+        g.blocks.push_back(std::move(block));
       }
       r.expect_end("$EndElements");
       seen_elements = true;
@@ -328,70 +350,207 @@ Mesh read_gmsh(const std::filesystem::path& file, double length_scale) {
   }
   if (!seen_format) r.fail("no $MeshFormat section: this is not a Gmsh MSH file");
   if (!seen_nodes || !seen_elements) r.fail("the file has no $Nodes or no $Elements section");
-  if (raw_cells.empty()) r.fail("the mesh has no quadrangles in any physical surface");
+  return g;
+}
+
+// Cells are the Q1 elements of dimension Dim, boundaries those of Dim - 1.
+template <int Dim>
+void check_blocks(const GmshFile& g, const MshReader& r) {
+  for (const auto& b : g.blocks) {
+    if (b.dim == Dim) {
+      if (b.type != q1_type[Dim - 1])
+        r.fail_at(b.line, Dim == 2 ? fmt::format("surface {} holds {}; the seepage solver needs 4-node "
+                                                 "quadrangles (add 'Recombine Surface{{...}};' to the .geo file)",
+                                                 b.entity, element_names(b.type))
+                                   : fmt::format("volume {} holds {}; the seepage solver needs 8-node hexahedra "
+                                                 "(make the volume and its surfaces transfinite and recombine them, "
+                                                 "or extrude a recombined surface with Layers{{...}}; Recombine;)",
+                                                 b.entity, element_names(b.type)));
+      if (b.physical < 0)
+        r.fail_at(b.line, fmt::format("{} {} belongs to no physical group, so its cells would have no region; add "
+                                      "it to a 'Physical {}'",
+                                      Dim == 2 ? "surface" : "volume", b.entity, Dim == 2 ? "Surface" : "Volume"));
+    } else if (b.dim == Dim - 1 && b.physical >= 0 && b.count > 0 && b.type != q1_type[Dim - 2]) {
+      r.fail_at(b.line, Dim == 2 ? fmt::format("curve {} holds {}; only 2-node lines are supported", b.entity,
+                                               element_names(b.type))
+                                 : fmt::format("surface {} of physical surface \"{}\" holds {}; the boundaries of a "
+                                               "hexahedral mesh need 4-node quadrangles (recombine the surface)",
+                                               b.entity, g.physical_name(2, b.physical), element_names(b.type)));
+    }
+  }
+}
+
+// A plane mesh's boundary lines, as they are listed.
+void add_boundaries(Mesh& mesh, const GmshFile& g, const std::unordered_map<long, int>& index,
+                    const std::filesystem::path& file) {
+  std::map<int, std::size_t> boundary_of_physical;
+  for (const auto& b : g.blocks) {
+    if (b.dim != 1 || b.tags.empty()) continue;
+    for (std::size_t e = 0; e < b.lines.size(); ++e) {
+      const long first = b.tags[2 * e], second = b.tags[2 * e + 1];
+      const auto a = index.find(first), c = index.find(second);
+      if (a == index.end() || c == index.end())
+        throw std::runtime_error(fmt::format("{}: a boundary line uses node {} or {}, which no quadrangle uses",
+                                             file.string(), first, second));
+      const auto [it, added] = boundary_of_physical.try_emplace(b.physical, mesh.boundaries.size());
+      if (added) mesh.boundaries.push_back({g.physical_name(1, b.physical), {}});
+      mesh.boundaries[it->second].faces.push_back({a->second, c->second});
+    }
+  }
+}
+
+// A volume mesh's boundary quadrangles, each replaced by the face of the
+// hexahedron it lies on as that hexahedron sees it, facing out (a face inside
+// the mesh: out of the first hexahedron listed that holds it).
+void add_boundaries(Mesh3& mesh, const GmshFile& g, const std::unordered_map<long, int>& index,
+                    const std::filesystem::path& file) {
+  // The cells around each node.
+  std::vector<int> start(mesh.num_nodes() + 1, 0), around;
+  for (const auto& cell : mesh.cells)
+    for (int node : cell) ++start[node + 1];
+  for (std::size_t i = 0; i < mesh.num_nodes(); ++i) start[i + 1] += start[i];
+  around.resize(static_cast<std::size_t>(start.back()));
+  std::vector<int> filled(start.begin(), start.end() - 1);
+  for (std::size_t c = 0; c < mesh.num_cells(); ++c)
+    for (int node : mesh.cells[c]) around[filled[node]++] = static_cast<int>(c);
+
+  const auto outward_face = [&](std::array<int, 4> nodes) -> std::optional<Mesh3::Face> {
+    std::sort(nodes.begin(), nodes.end());
+    for (int k = start[nodes[0]]; k < start[nodes[0] + 1]; ++k) {
+      const auto& cell = mesh.cells[around[k]];
+      for (const auto& local : q1::hex_face) {
+        Mesh3::Face face{cell[local[0]], cell[local[1]], cell[local[2]], cell[local[3]]};
+        auto sorted = face;
+        std::sort(sorted.begin(), sorted.end());
+        if (sorted == nodes) return face;
+      }
+    }
+    return std::nullopt;
+  };
+  std::map<int, std::size_t> boundary_of_physical;
+  for (const auto& b : g.blocks) {
+    if (b.dim != 2 || b.tags.empty()) continue;
+    for (std::size_t e = 0; e < b.lines.size(); ++e) {
+      std::array<int, 4> nodes{};
+      for (int a = 0; a < 4; ++a) {
+        const long tag = b.tags[4 * e + a];
+        const auto found = index.find(tag);
+        if (found == index.end())
+          throw std::runtime_error(fmt::format("{}:{}: this boundary quadrangle uses node {}, which no hexahedron uses",
+                                               file.string(), b.lines[e], tag));
+        nodes[a] = found->second;
+      }
+      const auto face = outward_face(nodes);
+      if (!face)
+        throw std::runtime_error(fmt::format("{}:{}: this quadrangle of physical surface \"{}\" is not a face of any "
+                                             "hexahedron: a boundary must lie on the cells' faces",
+                                             file.string(), b.lines[e], g.physical_name(2, b.physical)));
+      const auto [it, added] = boundary_of_physical.try_emplace(b.physical, mesh.boundaries.size());
+      if (added) mesh.boundaries.push_back({g.physical_name(2, b.physical), {}});
+      mesh.boundaries[it->second].faces.push_back(*face);
+    }
+  }
+}
+
+// The cells, regions and boundaries of a plane (Dim = 2) or volume mesh.
+template <int Dim>
+MeshOf<Dim> build_mesh(const GmshFile& g, const MshReader& r, const std::filesystem::path& file) {
+  check_blocks<Dim>(g, r);
+  constexpr int N = MeshOf<Dim>::cell_corners;
+  const char* cell_word = Dim == 2 ? "quadrangle" : "hexahedron";
+  const bool has_cells =
+      std::any_of(g.blocks.begin(), g.blocks.end(), [](const ElementBlock& b) { return b.dim == Dim && b.count > 0; });
+  if (!has_cells) r.fail("the mesh has no quadrangles in any physical surface");
 
   // Keep only nodes that cells use (Gmsh also stores geometry points), numbered
   // in order of first use.
-  Mesh mesh;
+  MeshOf<Dim> mesh;
   std::unordered_map<long, int> index;
   std::map<int, int> region_of_physical;
   const auto node_index = [&](long tag, int line) {
     const auto found = index.find(tag);
     if (found != index.end()) return found->second;
-    const auto xy = node_xy.find(tag);
-    if (xy == node_xy.end())
+    const auto xyz = g.nodes.find(tag);
+    if (xyz == g.nodes.end())
       throw std::runtime_error(
           fmt::format("{}:{}: the element uses node {}, which $Nodes does not define", file.string(), line, tag));
     const int i = static_cast<int>(mesh.nodes.size());
-    mesh.nodes.push_back(xy->second);
+    mesh.nodes.push_back(xyz->second.template head<Dim>());
     index[tag] = i;
     return i;
   };
-  // A quadrangle given twice would count its area, storage and conductivity twice.
-  std::map<std::array<long, 4>, int> line_of_cell;
-  for (const auto& c : raw_cells) {
-    auto nodes = c.tags;
-    std::sort(nodes.begin(), nodes.end());
-    if (const auto [it, added] = line_of_cell.try_emplace(nodes, c.line); !added)
-      throw std::runtime_error(fmt::format("{}:{}: this quadrangle has the nodes of the one at line {}: a cell "
-                                           "given twice",
-                                           file.string(), c.line, it->second));
-  }
-  for (const auto& c : raw_cells) {
-    std::array<int, 4> cell{};
-    for (int k = 0; k < 4; ++k) cell[k] = node_index(c.tags[k], c.line);
-    const auto [it, added] =
-        region_of_physical.try_emplace(c.physical, static_cast<int>(mesh.region_names.size()));
-    if (added) {
-      const auto name = physical_names.find({2, c.physical});
-      mesh.region_names.push_back(name != physical_names.end() ? name->second
-                                                               : fmt::format("{}", c.physical));
+  // A cell given twice would count its volume, storage and conductivity twice.
+  std::map<std::array<long, N>, int> line_of_cell;
+  for (const auto& b : g.blocks) {
+    if (b.dim != Dim) continue;
+    for (std::size_t e = 0; e < b.lines.size(); ++e) {
+      std::array<long, N> nodes;
+      std::copy_n(b.tags.begin() + static_cast<std::ptrdiff_t>(N * e), N, nodes.begin());
+      std::sort(nodes.begin(), nodes.end());
+      if (const auto [it, added] = line_of_cell.try_emplace(nodes, b.lines[e]); !added)
+        throw std::runtime_error(fmt::format("{}:{}: this {} has the nodes of the one at line {}: a cell given twice",
+                                             file.string(), b.lines[e], cell_word, it->second));
     }
-    // Gmsh orients quads by the surface normal; we need counter-clockwise in x-y.
-    const auto& p = mesh.nodes;
-    const double twice_area = (p[cell[2]] - p[cell[0]]).x() * (p[cell[3]] - p[cell[1]]).y() -
-                              (p[cell[2]] - p[cell[0]]).y() * (p[cell[3]] - p[cell[1]]).x();
-    if (twice_area < 0) std::swap(cell[1], cell[3]);
-    mesh.cells.push_back(cell);
-    mesh.cell_region.push_back(it->second);
   }
-  std::map<int, std::size_t> boundary_of_physical;
-  for (const auto& e : raw_edges) {
-    const auto a = index.find(e.tags[0]), b = index.find(e.tags[1]);
-    if (a == index.end() || b == index.end())
-      throw std::runtime_error(fmt::format(
-          "{}: a boundary line uses node {} or {}, which no quadrangle uses", file.string(),
-          e.tags[0], e.tags[1]));
-    const auto [it, added] = boundary_of_physical.try_emplace(e.physical, mesh.boundaries.size());
-    if (added) {
-      const auto name = physical_names.find({1, e.physical});
-      mesh.boundaries.push_back(
-          {name != physical_names.end() ? name->second : fmt::format("{}", e.physical), {}});
+  for (const auto& b : g.blocks) {
+    if (b.dim != Dim) continue;
+    for (std::size_t e = 0; e < b.lines.size(); ++e) {
+      typename MeshOf<Dim>::Cell cell{};
+      for (int k = 0; k < N; ++k) cell[k] = node_index(b.tags[N * e + k], b.lines[e]);
+      const auto [it, added] =
+          region_of_physical.try_emplace(b.physical, static_cast<int>(mesh.region_names.size()));
+      if (added) mesh.region_names.push_back(g.physical_name(Dim, b.physical));
+      const auto& p = mesh.nodes;
+      if constexpr (Dim == 2) {
+        // Gmsh orients quads by the surface normal; we need counter-clockwise in x-y.
+        const double twice_area = (p[cell[2]] - p[cell[0]]).x() * (p[cell[3]] - p[cell[1]]).y() -
+                                  (p[cell[2]] - p[cell[0]]).y() * (p[cell[3]] - p[cell[1]]).x();
+        if (twice_area < 0) std::swap(cell[1], cell[3]);
+      } else {
+        // Gmsh's hexahedra have q1::hex_corner's order, but a mirrored one (its
+        // volume's orientation) maps the reference cube inside out: exchanging
+        // xi and eta turns it right-handed. A twisted or collapsed one stays
+        // so, for check_mesh to refuse.
+        q1::Corners3 x;
+        for (int a = 0; a < 8; ++a) x[a] = p[cell[a]];
+        if (q1::evaluate(x, Eigen::Vector3d::Zero()).det_j < 0) {
+          std::swap(cell[1], cell[3]);
+          std::swap(cell[5], cell[7]);
+        }
+      }
+      mesh.cells.push_back(cell);
+      mesh.cell_region.push_back(it->second);
     }
-    mesh.boundaries[it->second].faces.push_back({a->second, b->second});
   }
+  // Before the boundaries: their faces are looked up on the cells.
   check_mesh(mesh, file.string());
+  add_boundaries(mesh, g, index, file);
   return mesh;
+}
+
+}  // namespace
+
+std::variant<Mesh, Mesh3> read_gmsh_mesh(const std::filesystem::path& file, double length_scale) {
+  MshReader r(file);
+  const GmshFile g = parse_gmsh(r, length_scale);
+  if (g.has_hexahedra()) return build_mesh<3>(g, r, file);
+  return build_mesh<2>(g, r, file);
+}
+
+Mesh read_gmsh(const std::filesystem::path& file, double length_scale) {
+  auto mesh = read_gmsh_mesh(file, length_scale);
+  if (!std::holds_alternative<Mesh>(mesh))
+    throw std::runtime_error(
+        fmt::format("{}: holds hexahedra, a volume mesh; a plane mesh (quadrangles) is needed here", file.string()));
+  return std::get<Mesh>(std::move(mesh));
+}
+
+Mesh3 read_gmsh3(const std::filesystem::path& file, double length_scale) {
+  auto mesh = read_gmsh_mesh(file, length_scale);
+  if (!std::holds_alternative<Mesh3>(mesh))
+    throw std::runtime_error(
+        fmt::format("{}: holds no hexahedra, a plane mesh; a volume mesh is needed here", file.string()));
+  return std::get<Mesh3>(std::move(mesh));
 }
 
 void check_mesh(const Mesh& mesh, const std::string& source) {
@@ -426,13 +585,15 @@ Mesh3 make_box_mesh(const BoxMeshSpec& spec) {
   for (int k = 0; k <= nz; ++k)
     for (int j = 0; j <= ny; ++j)
       for (int i = 0; i <= nx; ++i) mesh.nodes.emplace_back(at[0][i], at[1][j], at[2][k]);
-  mesh.region_names = {"domain"};
+  for (const auto& r : spec.regions) mesh.region_names.push_back(r.name);
   for (int k = 0; k < nz; ++k)
     for (int j = 0; j < ny; ++j)
       for (int i = 0; i < nx; ++i) {
         mesh.cells.push_back({id(i, j, k), id(i + 1, j, k), id(i + 1, j + 1, k), id(i, j + 1, k), id(i, j, k + 1),
                               id(i + 1, j, k + 1), id(i + 1, j + 1, k + 1), id(i, j + 1, k + 1)});
-        mesh.cell_region.push_back(0);
+        const Eigen::Vector3d centre(0.5 * (at[0][i] + at[0][i + 1]), 0.5 * (at[1][j] + at[1][j + 1]),
+                                     0.5 * (at[2][k] + at[2][k + 1]));
+        mesh.cell_region.push_back(region_holding(spec.regions, centre));
       }
   Mesh3::Boundary left{"left", {}}, right{"right", {}}, bottom{"bottom", {}}, top{"top", {}}, back{"back", {}},
       front{"front", {}};

@@ -1,7 +1,7 @@
 #pragma once
-// Meshes for the seepage solver: generated structured rectangles (with optional
-// geometric grading) or unstructured quads read from Gmsh; generated boxes of
-// hexahedra in 3D.
+// Meshes for the seepage solver: generated rectangles and boxes (with optional
+// geometric grading), or unstructured quadrilaterals and hexahedra read from
+// Gmsh.
 //
 // Regions (cell sets with their own material) and boundaries (sets of faces,
 // edges in 2D, where conditions apply) are named: "left", "right", "bottom",
@@ -11,6 +11,7 @@
 #include <array>
 #include <filesystem>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include <Eigen/Core>
@@ -62,17 +63,22 @@ struct MeshOf {
 using Mesh = MeshOf<2>;
 using Mesh3 = MeshOf<3>;
 
+// A region of a generated mesh: the whole mesh, or the cells whose centres
+// lie in a box (its corners of least and greatest coordinates).
+template <int Dim>
+struct RegionBoxOf {
+  std::string name;
+  bool whole_domain = true;
+  Eigen::Matrix<double, Dim, 1> box_min, box_max;
+};
+
 struct StructuredMeshSpec {
   Eigen::Vector2d origin{0.0, 0.0};
   Eigen::Vector2d size{1.0, 1.0};
   std::array<int, 2> cells{1, 1};
   // Ratio of the last to the first cell size in each direction (1: uniform).
   std::array<double, 2> grading{1.0, 1.0};
-  struct Region {
-    std::string name;
-    bool whole_domain = true;
-    Eigen::Vector2d box_min, box_max;
-  };
+  using Region = RegionBoxOf<2>;
   // A cell belongs to the last region whose box holds its centre.
   std::vector<Region> regions;
 };
@@ -82,19 +88,32 @@ Mesh make_structured_mesh(const StructuredMeshSpec& spec);
 
 // A box of hexahedra, uniform or graded along each axis; its boundaries are
 // "left" and "right" (x), "bottom" and "top" (y), "back" and "front" (z), each
-// face's corners counter-clockwise seen from outside. One region, "domain".
+// face's corners counter-clockwise seen from outside. Regions as on the
+// rectangle, by default one, "domain".
 struct BoxMeshSpec {
   Eigen::Vector3d origin{0.0, 0.0, 0.0};
   Eigen::Vector3d size{1.0, 1.0, 1.0};
   std::array<int, 3> cells{1, 1, 1};
   std::array<double, 3> grading{1.0, 1.0, 1.0};  // last over first cell size
+  using Region = RegionBoxOf<3>;
+  std::vector<Region> regions{{"domain", true, {}, {}}};
 };
+// Throws std::invalid_argument for a size or cell count below one, and, as
+// make_structured_mesh, for a cell in no region.
 Mesh3 make_box_mesh(const BoxMeshSpec& spec);
 
-// Gmsh MSH 4.1 ASCII with physical groups: 2D groups become regions (4-node quads
-// only), 1D groups boundaries. Coordinates are multiplied by `length_scale` (to m).
-// Errors (std::runtime_error) name the file, the line and what was expected.
+// Gmsh MSH 4.1 ASCII with physical groups, plane or volume as the file holds.
+// A mesh with hexahedra (8-node, element type 5) is a volume mesh: physical
+// volumes become regions and physical surfaces (4-node quadrangles)
+// boundaries, each face turned to face out of its hexahedron. Otherwise it is
+// plane: physical surfaces (4-node quadrangles only) become regions and
+// physical curves (2-node lines) boundaries. Coordinates are multiplied by
+// `length_scale` (to m). Errors (std::runtime_error) name the file, the line
+// and what was expected.
+std::variant<Mesh, Mesh3> read_gmsh_mesh(const std::filesystem::path& file, double length_scale = 1.0);
+// The same, for a mesh that must be plane, or must be a volume mesh.
 Mesh read_gmsh(const std::filesystem::path& file, double length_scale = 1.0);
+Mesh3 read_gmsh3(const std::filesystem::path& file, double length_scale = 1.0);
 
 // Checks every cell has positive area and counter-clockwise, convex corners
 // (a hexahedron: a positive Jacobian at each corner); throws

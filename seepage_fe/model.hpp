@@ -45,8 +45,9 @@ struct BoundaryCondition {
   enum class Type { pressure, flux };
   std::string boundary;  // a mesh boundary name
   Type type;
-  // pressure: p [Pa]; flux: inflow per unit boundary length and depth [m/s]
-  // (standard gas volume for the gas law), positive into the domain.
+  // pressure: p [Pa]; flux: inflow per unit boundary area (2D: per unit
+  // length and depth) [m/s] (standard gas volume for the gas law), positive
+  // into the domain.
   TimeFunction value;
 };
 

@@ -150,6 +150,10 @@ using Corners3 = std::array<Eigen::Vector3d, 8>;
 // seen from +zeta, from (-1, -1, -1), then the face zeta = +1 the same way.
 inline constexpr double hex_corner[8][3] = {{-1, -1, -1}, {1, -1, -1}, {1, 1, -1}, {-1, 1, -1},
                                             {-1, -1, 1},  {1, -1, 1},  {1, 1, 1},  {-1, 1, 1}};
+// Its six faces, zeta = -1, +1, eta = -1, +1, xi = -1, +1, each by its corners
+// counter-clockwise seen from outside.
+inline constexpr int hex_face[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4},
+                                       {3, 7, 6, 2}, {0, 4, 7, 3}, {1, 2, 6, 5}};
 
 inline std::array<double, 8> shape(const Eigen::Vector3d& r) {
   std::array<double, 8> n{};

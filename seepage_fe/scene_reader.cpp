@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <type_traits>
 #include <variant>
 
 #include <fmt/format.h>
@@ -18,51 +19,82 @@ using scene::Range;
 namespace {
 
 // What the solver holds per node, counted low: the mesh, the sparse Jacobian
-// and CHOLMOD's factor (measured: 1.4 kB per node at 1e6 nodes).
+// and CHOLMOD's factor (measured: 1.4 kB per node at 1e6 nodes, in 2D; a 3D
+// node's row couples 27 nodes instead of 9, and its factor fills in more, so
+// the bound is lower still there).
 constexpr double bytes_per_node = 1000;
 
-// A Gmsh mesh is read at once; a structured one is returned as its spec so the
-// regions can be painted into it before it is generated.
-std::variant<Mesh, StructuredMeshSpec> read_mesh(const scene::Table& t) {
-  const std::string type =
-      t.choice({"type", "\"structured\": a generated rectangle; \"gmsh\": a quad mesh file",
-                "structured"},
-               {"structured", "gmsh"});
+// What [seepage.mesh] describes. A Gmsh mesh is read at once; a generated
+// one is returned as its spec so the regions can be painted into it before it
+// is generated.
+template <int Dim>
+using GeneratedSpec = std::conditional_t<Dim == 2, StructuredMeshSpec, BoxMeshSpec>;
+using MeshInput = std::variant<Mesh, StructuredMeshSpec, Mesh3, BoxMeshSpec>;
+
+Mesh generate(const StructuredMeshSpec& spec) { return make_structured_mesh(spec); }
+Mesh3 generate(const BoxMeshSpec& spec) { return make_box_mesh(spec); }
+
+// A rectangle (Dim = 2) or a box: its corner, size, cells and grading.
+template <int Dim>
+GeneratedSpec<Dim> read_generated(const scene::Table& t) {
+  constexpr bool plane = Dim == 2;
+  const auto origin = t.quantity_vector(
+      {"origin", plane ? "lower-left corner" : "the corner of least x, y and z", plane ? "0 m, 0 m" : "0 m, 0 m, 0 m"},
+      units::length, Dim);
+  const auto size = t.quantity_vector(
+      {"size", plane ? "width and height" : "lengths along x, y and z", "", Range::positive()}, units::length, Dim);
+  const auto cells = t.integer_vector<int>(
+      {"cells", plane ? "number of cells along x and y" : "number of cells along x, y and z", "", Range::at_least(1)},
+      Dim);
+  // Nodes are numbered with int, and must fit in memory.
+  double nodes = 1;
+  for (const int c : cells) nodes *= c + 1.0;
+  if (nodes > std::numeric_limits<int>::max())
+    t.fail("cells", fmt::format("{} cells have {:.3g} nodes, more than the {} a mesh may have", fmt::join(cells, " x "),
+                                nodes, std::numeric_limits<int>::max()));
+  limits::refuse_memory(t, "cells", nodes * bytes_per_node,
+                        fmt::format("a mesh of {} cells ({:.3g} nodes)", fmt::join(cells, " x "), nodes));
+  const auto grading = t.number_vector(
+      {"grading",
+       plane ? "ratio of the last to the first cell size along x and y (1: uniform)"
+             : "ratio of the last to the first cell size along x, y and z (1: uniform)",
+       plane ? "1, 1" : "1, 1, 1", Range::positive()},
+      Dim);
+  GeneratedSpec<Dim> spec;
+  for (int d = 0; d < Dim; ++d) {
+    spec.origin[d] = origin[d];
+    spec.size[d] = size[d];
+    spec.cells[d] = cells[d];
+    spec.grading[d] = grading[d];
+  }
+  return spec;
+}
+
+MeshInput read_mesh(const scene::Table& t) {
+  const std::string type = t.choice(
+      {"type",
+       "\"structured\": a generated rectangle; \"box\": a generated box of hexahedra (3D); \"gmsh\": a mesh file, "
+       "of quadrangles (plane) or hexahedra (3D)",
+       "structured"},
+      {"structured", "box", "gmsh"});
   if (type == "gmsh") {
     const auto file = t.file({"file", "Gmsh MSH 4.1 ASCII file, relative to the scene file"});
     const double scale = t.quantity(
         {"length_unit", "length of one coordinate unit in the mesh file", "1 m", Range::positive()},
         units::length);
-    Mesh mesh;
+    std::variant<Mesh, Mesh3> mesh;
     try {
-      mesh = read_gmsh(file, scale);
+      mesh = read_gmsh_mesh(file, scale);
     } catch (const std::runtime_error& e) {
       t.fail("file", e.what());
     }
-    limits::refuse_memory(t, "file", static_cast<double>(mesh.num_nodes()) * bytes_per_node,
-                          fmt::format("a mesh of {} nodes", mesh.num_nodes()));
-    return mesh;
+    const std::size_t nodes = std::visit([](const auto& m) { return m.num_nodes(); }, mesh);
+    limits::refuse_memory(t, "file", static_cast<double>(nodes) * bytes_per_node,
+                          fmt::format("a mesh of {} nodes", nodes));
+    return std::visit([](auto& m) -> MeshInput { return std::move(m); }, mesh);
   }
-  StructuredMeshSpec spec;
-  const auto origin = t.quantity_vector({"origin", "lower-left corner", "0 m, 0 m"}, units::length, 2);
-  const auto size = t.quantity_vector({"size", "width and height", "", Range::positive()}, units::length, 2);
-  const auto cells = t.integer_vector<int>({"cells", "number of cells along x and y", "", Range::at_least(1)}, 2);
-  // Nodes are numbered with int, and must fit in memory.
-  const double nodes = (cells[0] + 1.0) * (cells[1] + 1.0);
-  if (nodes > std::numeric_limits<int>::max())
-    t.fail("cells", fmt::format("{} x {} cells have {:.3g} nodes, more than the {} a mesh may have", cells[0],
-                                cells[1], nodes, std::numeric_limits<int>::max()));
-  limits::refuse_memory(t, "cells", nodes * bytes_per_node,
-                        fmt::format("a mesh of {} x {} cells ({:.3g} nodes)", cells[0], cells[1], nodes));
-  const auto grading = t.number_vector(
-      {"grading", "ratio of the last to the first cell size along x and y (1: uniform)", "1, 1",
-       Range::positive()},
-      2);
-  spec.origin = {origin[0], origin[1]};
-  spec.size = {size[0], size[1]};
-  spec.cells = {cells[0], cells[1]};
-  spec.grading = {grading[0], grading[1]};
-  return spec;
+  if (type == "box") return read_generated<3>(t);
+  return read_generated<2>(t);
 }
 
 Material read_material(const scene::Table& r, Law law) {
@@ -104,8 +136,7 @@ Material read_material(const scene::Table& r, Law law) {
 }
 
 // The solver's own settings: time scheme, nonlinear solver and its limits.
-void read_settings(const scene::Table& s, Setup& setup) {
-  Settings& st = setup.settings;
+void read_settings(const scene::Table& s, Settings& st) {
   st.scheme = s.choice<TimeScheme>({"time_scheme", "\"bdf2\" (second order, L-stable) or \"backward_euler\"", "bdf2"},
                                    {{"bdf2", TimeScheme::bdf2}, {"backward_euler", TimeScheme::backward_euler}});
   st.method = s.choice<NonlinearMethod>(
@@ -150,46 +181,59 @@ void read_settings(const scene::Table& s, Setup& setup) {
 }
 
 // The step sizes of a run of its own (a coupled run's window sets them).
-void read_time_steps(const scene::Table& s, Setup& setup, bool own_time_steps) {
-  setup.steps.maximum = std::numeric_limits<double>::infinity();
+void read_time_steps(const scene::Table& s, TimeStepControl& steps, bool own_time_steps) {
+  steps.maximum = std::numeric_limits<double>::infinity();
   if (own_time_steps) {
-    setup.steps.first = s.quantity({"time_step", "first time step", "", Range::positive()}, units::time);
-    setup.steps.growth = s.number({"time_step_growth", "factor between successive steps (1: constant; up to 2)",
-                                   "1", Range::between(1, 2)});
+    steps.first = s.quantity({"time_step", "first time step", "", Range::positive()}, units::time);
+    steps.growth = s.number({"time_step_growth", "factor between successive steps (1: constant; up to 2)", "1",
+                             Range::between(1, 2)});
     if (s.has("max_time_step")) {
-      setup.steps.maximum = s.quantity(
-          {"max_time_step", "largest step when time_step_growth > 1", "", Range::positive()}, units::time);
-      if (setup.steps.maximum < setup.steps.first)
-        s.fail("max_time_step", fmt::format("{:g} s is below the first step, time_step = {:g} s", setup.steps.maximum,
-                                            setup.steps.first));
+      steps.maximum = s.quantity({"max_time_step", "largest step when time_step_growth > 1", "", Range::positive()},
+                                 units::time);
+      if (steps.maximum < steps.first)
+        s.fail("max_time_step",
+               fmt::format("{:g} s is below the first step, time_step = {:g} s", steps.maximum, steps.first));
     }
   }
-
 }
 
-// On a generated mesh, boxes paint regions over the rectangle, in order: a cell
-// takes the last region whose box holds its centre.
-void read_painted_regions(const std::vector<scene::Table>& regions, const scene::Table& s, StructuredMeshSpec& spec,
-                          Setup& setup) {
+// On a generated mesh, boxes paint regions over the rectangle or box, in
+// order: a cell takes the last region whose box holds its centre.
+template <int Dim>
+void read_painted_regions(const std::vector<scene::Table>& regions, const scene::Table& s, GeneratedSpec<Dim>& spec,
+                          SetupOf<Dim>& setup) {
+  constexpr bool plane = Dim == 2;
   Model& model = setup.model;
-  Mesh& mesh = setup.mesh;
+  MeshOf<Dim>& mesh = setup.mesh;
+  spec.regions.clear();
   for (const auto& r : regions) {
-    StructuredMeshSpec::Region region;
+    RegionBoxOf<Dim> region;
     region.name = r.string({"name", "region name (used in output and messages)"});
     region.whole_domain = !r.has("box_min");
     if (!region.whole_domain) {
-      const auto lo = r.quantity_vector({"box_min", "lower-left corner of the region's box"}, units::length, 2);
-      const auto hi = r.quantity_vector({"box_max", "upper-right corner of the region's box"}, units::length, 2);
-      region.box_min = {lo[0], lo[1]};
-      region.box_max = {hi[0], hi[1]};
+      const auto lo = r.quantity_vector(
+          {"box_min", plane ? "lower-left corner of the region's box" : "corner of least x, y and z of the region's box"},
+          units::length, Dim);
+      const auto hi = r.quantity_vector({"box_max", plane ? "upper-right corner of the region's box"
+                                                          : "corner of greatest x, y and z of the region's box"},
+                                        units::length, Dim);
+      for (int d = 0; d < Dim; ++d) {
+        region.box_min[d] = lo[d];
+        region.box_max[d] = hi[d];
+      }
     }
     spec.regions.push_back(region);
     model.materials.push_back(read_material(r, model.law));
   }
   try {
-    mesh = make_structured_mesh(spec);
+    mesh = generate(spec);
   } catch (const std::invalid_argument& e) {
     s.fail("regions", e.what());
+  } catch (const std::runtime_error& e) {  // check_mesh: cells graded or sized below round-off
+    s.table("mesh", "the finite element mesh", true)
+        ->fail("grading", fmt::format("{}: its cells are too thin to compute with; make the grading milder, or the "
+                                      "box larger or of fewer cells",
+                                      e.what()));
   }
   // A cell takes the last region whose box holds it: a region left with no
   // cell was painted over, which the scene cannot have meant.
@@ -204,36 +248,42 @@ void read_painted_regions(const std::vector<scene::Table>& regions, const scene:
                                                                   "later region"));
 }
 
-// On a Gmsh mesh, each physical surface must have a region of the same name.
-void read_named_regions(const std::vector<scene::Table>& regions, const scene::Table& s, Setup& setup) {
+// On a Gmsh mesh, each physical surface (3D: volume) must have a region of the
+// same name.
+template <int Dim>
+void read_named_regions(const std::vector<scene::Table>& regions, const scene::Table& s, SetupOf<Dim>& setup) {
+  const char* group = Dim == 2 ? "physical surface" : "physical volume";
   Model& model = setup.model;
-  const Mesh& mesh = setup.mesh;
+  const MeshOf<Dim>& mesh = setup.mesh;
   model.materials.resize(mesh.region_names.size());
   std::vector<bool> given(mesh.region_names.size(), false);
   for (const auto& r : regions) {
-    const std::string name = r.string({"name", "a physical surface name of the Gmsh mesh"});
+    const std::string name = r.string(
+        {"name", Dim == 2 ? "a physical surface name of the Gmsh mesh" : "a physical volume name of the Gmsh mesh"});
     const int index = mesh.region_index(name);
     if (index < 0)
-      r.fail("name", fmt::format("the mesh has no physical surface \"{}\" (it has: {})", name,
-                                 fmt::join(mesh.region_names, ", ")));
+      r.fail("name",
+             fmt::format("the mesh has no {} \"{}\" (it has: {})", group, name, fmt::join(mesh.region_names, ", ")));
     if (given[index]) r.fail("name", fmt::format("region \"{}\" is given twice", name));
     given[index] = true;
     model.materials[index] = read_material(r, model.law);
   }
   for (std::size_t i = 0; i < given.size(); ++i)
     if (!given[i])
-      s.fail("regions", fmt::format("the mesh's physical surface \"{}\" has no [[seepage.regions]] "
-                                    "entry",
-                                    mesh.region_names[i]));
+      s.fail("regions",
+             fmt::format("the mesh's {} \"{}\" has no [[seepage.regions]] entry", group, mesh.region_names[i]));
 }
 
-void read_boundaries(const scene::Table& s, Setup& setup) {
+template <int Dim>
+void read_boundaries(const scene::Table& s, SetupOf<Dim>& setup) {
   Model& model = setup.model;
-  const Mesh& mesh = setup.mesh;
+  const MeshOf<Dim>& mesh = setup.mesh;
   for (const auto& b : s.table_array("boundaries", "boundary conditions (others: no flow)")) {
     BoundaryCondition bc;
-    bc.boundary = b.string({"name", "a boundary of the mesh: left, right, bottom, top on a "
-                                    "generated mesh, a physical curve name on a Gmsh mesh"});
+    bc.boundary = b.string({"name", Dim == 2 ? "a boundary of the mesh: left, right, bottom, top on a generated mesh, "
+                                               "a physical curve name on a Gmsh mesh"
+                                             : "a boundary of the mesh: left, right, bottom, top, back, front on a "
+                                               "box, a physical surface name on a Gmsh mesh"});
     if (!mesh.boundary(bc.boundary))
       b.fail("name", fmt::format("the mesh has no boundary \"{}\" (it has: {})", bc.boundary,
                                  fmt::join(mesh.boundary_names(), ", ")));
@@ -258,30 +308,56 @@ void read_boundaries(const scene::Table& s, Setup& setup) {
   }
 }
 
-}  // namespace
-
-Setup read_setup(const scene::Table& s, bool own_time_steps) {
-  Setup setup;
-  Model& model = setup.model;
-  model.law = s.choice<Law>({"law",
-                             "\"gas\": P = p^2 with gas content A sqrt(p) (the paper's); \"linear\": "
-                             "Darcy flow of a slightly compressible fluid, unknown p",
-                             "gas"},
-                            {{"gas", Law::gas}, {"linear", Law::linear}});
-  read_settings(s, setup);
-  read_time_steps(s, setup, own_time_steps);
-  auto mesh_or_spec = read_mesh(*s.table("mesh", "the finite element mesh", true));
-  const auto regions = s.table_array("regions", "materials and initial pressure per region");
-  if (regions.empty())
-    s.fail("regions", "give at least one [[seepage.regions]] with its material and initial pressure");
-  if (auto* spec = std::get_if<StructuredMeshSpec>(&mesh_or_spec)) {
-    read_painted_regions(regions, s, *spec, setup);
-  } else {
-    setup.mesh = std::move(std::get<Mesh>(mesh_or_spec));
+// The regions and boundaries on a mesh read (named regions) or generated
+// (painted ones).
+template <int Dim, class MeshOrSpec>
+SetupOf<Dim> complete_setup(MeshOrSpec& input, const std::vector<scene::Table>& regions, const scene::Table& s,
+                            SetupOf<Dim> setup) {
+  if constexpr (std::is_same_v<MeshOrSpec, MeshOf<Dim>>) {
+    setup.mesh = std::move(input);
     read_named_regions(regions, s, setup);
+  } else {
+    read_painted_regions(regions, s, input, setup);
   }
   read_boundaries(s, setup);
   return setup;
+}
+
+}  // namespace
+
+std::variant<Setup, Setup3> read_any_setup(const scene::Table& s, bool own_time_steps) {
+  // The law, settings and steps come before the mesh tells the dimension: a
+  // plane setup holds them, and hands them to a 3D one if the mesh is 3D.
+  Setup plane;
+  plane.model.law = s.choice<Law>({"law",
+                                   "\"gas\": P = p^2 with gas content A sqrt(p) (the paper's); \"linear\": "
+                                   "Darcy flow of a slightly compressible fluid, unknown p",
+                                   "gas"},
+                                  {{"gas", Law::gas}, {"linear", Law::linear}});
+  read_settings(s, plane.settings);
+  read_time_steps(s, plane.steps, own_time_steps);
+  auto input = read_mesh(*s.table("mesh", "the finite element mesh", true));
+  const auto regions = s.table_array("regions", "materials and initial pressure per region");
+  if (regions.empty())
+    s.fail("regions", "give at least one [[seepage.regions]] with its material and initial pressure");
+  return std::visit(
+      [&](auto& mesh_or_spec) -> std::variant<Setup, Setup3> {
+        using Input = std::decay_t<decltype(mesh_or_spec)>;
+        if constexpr (std::is_same_v<Input, Mesh> || std::is_same_v<Input, StructuredMeshSpec>)
+          return complete_setup<2>(mesh_or_spec, regions, s, std::move(plane));
+        else
+          return complete_setup<3>(mesh_or_spec, regions, s, Setup3{{}, plane.model, plane.settings, plane.steps});
+      },
+      input);
+}
+
+Setup read_setup(const scene::Table& s, bool own_time_steps) {
+  auto setup = read_any_setup(s, own_time_steps);
+  if (auto* plane = std::get_if<Setup>(&setup)) return std::move(*plane);
+  const auto mesh = s.table("mesh", "the finite element mesh", true);
+  mesh->fail(mesh->has("file") ? "file" : "type",
+             "a 3D mesh (hexahedra), where this program couples the seepage to a plane solid: give a plane mesh "
+             "(\"structured\", or a Gmsh file of quadrangles); seepage-fe runs 3D scenes on their own");
 }
 
 }  // namespace outburst::seepage

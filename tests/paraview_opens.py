@@ -1,18 +1,30 @@
 """ParaView opens what a program writes: run a scene, read its XDMF with
 ParaView's own reader (by absolute path), and check times, topology and fields.
+With --hexahedra VOLUME every cell must be a hexahedron whose corners VTK
+reads in its own order (a positive Jacobian at every corner: a mirrored or
+scrambled order gives a negative or twisted one) and the cells must fill
+VOLUME [m3].
 
-usage: pvpython paraview_opens.py PROGRAM SCENE WORKDIR XDMF_NAME FIELDS [--set ...]...
+usage: pvpython paraview_opens.py PROGRAM SCENE WORKDIR XDMF_NAME FIELDS [--hexahedra VOLUME] [--set ...]...
 FIELDS is a comma-separated list of the point and cell arrays expected.
 """
+import math
 import os
 import subprocess
 import sys
 
-from paraview.simple import XDMFReader, servermanager
+from paraview.simple import CellSize, MeshQuality, XDMFReader, servermanager
+
+VTK_HEXAHEDRON = 12
 
 program, scene, workdir, xdmf_name, fields = sys.argv[1:6]
+rest = sys.argv[6:]
+volume = None
+if rest[:1] == ["--hexahedra"]:
+    volume = float(rest[1])
+    rest = rest[2:]
 out = os.path.abspath(os.path.join(workdir, "out"))
-subprocess.run([program, scene, "--quiet", "-o", out, "--overwrite"] + sys.argv[6:], check=True)
+subprocess.run([program, scene, "--quiet", "-o", out, "--overwrite"] + rest, check=True)
 reader = XDMFReader(FileNames=[os.path.join(out, xdmf_name)])
 reader.UpdatePipelineInformation()
 times = list(reader.TimestepValues)
@@ -30,3 +42,15 @@ for i in range(points.GetNumberOfArrays()):
     assert low == low and high == high, f"NaN in {points.GetArrayName(i)}"
 print(f"ParaView read {len(times)} times, {data.GetNumberOfPoints()} points, "
       f"{data.GetNumberOfCells()} cells, fields {names}")
+if volume is not None:
+    types = {data.GetCellType(i) for i in range(data.GetNumberOfCells())}
+    assert types == {VTK_HEXAHEDRON}, f"cell types {types}, expected hexahedra ({VTK_HEXAHEDRON}) only"
+    quality = MeshQuality(Input=reader)
+    quality.HexQualityMeasure = "Jacobian"
+    jacobians = servermanager.Fetch(quality).GetCellData().GetArray("Quality").GetRange()
+    sizes = servermanager.Fetch(CellSize(Input=reader)).GetCellData().GetArray("Volume")
+    total = math.fsum(sizes.GetValue(i) for i in range(sizes.GetNumberOfTuples()))
+    print(f"  hexahedra only; smallest corner Jacobian {jacobians[0]:.4g}; cells fill {total:.12g} m3 "
+          f"(expected {volume:g})")
+    assert jacobians[0] > 0, f"a hexahedron VTK reads inside out (corner Jacobian {jacobians[0]})"
+    assert abs(total - volume) <= 1e-9 * volume, f"the cells fill {total} m3, expected {volume}"

@@ -40,6 +40,10 @@ CASES = [
     Case("drainage", "seepage_fe/seepage-fe", "drainage/drainage.toml",
          ['seepage.max_time_step="30 min"', 'output.checkpoint_interval="1 d"'], 1,
          [(signal.SIGKILL, "run"), (signal.SIGTERM, "run")], ["seepage.xdmf"], ["seepage_history.csv"]),
+    # In 3D: hexahedra, and a supernodal CHOLMOD factor set up afresh on restart.
+    Case("drainage in 3D", "seepage_fe/seepage-fe", "drainage_3d/drainage_3d.toml",
+         ['scene.end_time="6 d"', 'output.interval="2 d"', 'output.checkpoint_interval="12 h"'], 1,
+         [(signal.SIGKILL, "run"), (signal.SIGTERM, "run")], ["seepage.xdmf"], ["seepage_history.csv"]),
     Case("granular collapse", "mpm_solid/mpm-solid", "granular_collapse/granular_collapse.toml",
          ['scene.end_time="0.2 s"', 'output.interval="0.05 s"', 'output.checkpoint_interval="0.01 s"'], 1,
          [(signal.SIGKILL, "run"), (signal.SIGTERM, "run")], ["particles.xdmf"], ["mpm_history.csv"]),

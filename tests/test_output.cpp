@@ -48,7 +48,7 @@ TEST_CASE("a series writes mesh, snapshots and an index listing only complete sn
   const auto dir = fresh_dir("series");
   output::RunInfo info{"test", "0.0", "scene.toml", "[scene]\ntitle = \"x\"\n", {"a.b=1"}, "SI"};
   output::FieldSeries series(dir, "run", info);
-  series.add_quad_mesh("mesh", {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0}, {0, 1, 2, 3});
+  series.add_mesh("mesh", {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0}, {0, 1, 2, 3}, output::CellShape::quadrilateral);
   series.add_point_grid("particles");
   for (int k = 0; k < 3; ++k) {
     output::Snapshot snap(0.5 * k);
@@ -60,6 +60,8 @@ TEST_CASE("a series writes mesh, snapshots and an index listing only complete sn
   }
   const std::string xdmf = read(series.index_path());
   CHECK_THAT(xdmf, Catch::Contains("run_000002.h5:/mesh/p"));
+  CHECK_THAT(xdmf, Catch::Contains("TopologyType=\"Quadrilateral\" NumberOfElements=\"1\""));
+  CHECK_THAT(xdmf, Catch::Contains("Dimensions=\"1 4\" NumberType=\"Int\" Precision=\"8\" Format=\"HDF\">run_mesh.h5:/cells"));
   CHECK_THAT(xdmf, Catch::Contains("TopologyType=\"Polyvertex\""));
   CHECK_THAT(xdmf, Catch::Contains("run_000002.h5:/particles/connectivity"));
   CHECK_THAT(xdmf, Catch::Contains("<Time Value=\"1\"/>"));
@@ -73,6 +75,30 @@ TEST_CASE("a series writes mesh, snapshots and an index listing only complete sn
   CHECK(r.string_attribute("/", "version") == "0.0");
   CHECK(r.string_attribute("/mesh/p", "unit") == "Pa");
   CHECK(r.number_attribute("/", "time") == 1.0);
+}
+
+TEST_CASE("a hexahedral mesh is written with its 8 corners per cell and indexed as hexahedra", "[output]") {
+  const auto dir = fresh_dir("hexahedra");
+  output::RunInfo info{"test", "0.0", "scene.toml", "", {}, "SI"};
+  output::FieldSeries series(dir, "run", info);
+  // Two unit cubes side by side along x.
+  std::vector<double> xyz;
+  for (int k = 0; k < 2; ++k)
+    for (int j = 0; j < 2; ++j)
+      for (int i = 0; i < 3; ++i) xyz.insert(xyz.end(), {1.0 * i, 1.0 * j, 1.0 * k});
+  // Node (i, j, k) is (k * 2 + j) * 3 + i.
+  const std::vector<std::int64_t> cells{0, 1, 4, 3, 6, 7, 10, 9, 1, 2, 5, 4, 7, 8, 11, 10};
+  series.add_mesh("mesh", xyz, cells, output::CellShape::hexahedron);
+  output::Snapshot snap(0.0);
+  snap.add("mesh", {"region", output::Center::cell, 1, "", {0, 1}});
+  series.write(snap);
+  const std::string xdmf = read(series.index_path());
+  CHECK_THAT(xdmf, Catch::Contains("TopologyType=\"Hexahedron\" NumberOfElements=\"2\""));
+  CHECK_THAT(xdmf, Catch::Contains("Dimensions=\"2 8\" NumberType=\"Int\" Precision=\"8\" Format=\"HDF\">run_mesh.h5:/cells"));
+  CHECK_THAT(xdmf, Catch::Contains("Dimensions=\"12 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">run_mesh.h5:/nodes"));
+  hdf5::H5Reader r(dir / "run_mesh.h5");
+  CHECK(r.shape("/cells") == std::vector<std::size_t>{2, 8});
+  CHECK(r.shape("/nodes") == std::vector<std::size_t>{12, 3});
 }
 
 TEST_CASE("a snapshot that cannot be finished (a full disk) fails with a clear error and leaves nothing",

@@ -96,6 +96,28 @@ TEST_CASE("a box of hexahedra: volume, face areas and orientation, and the patch
   CHECK(interior == 8);
 }
 
+TEST_CASE("a box paints regions by box as the rectangle does", "[seepage][3d][mesh]") {
+  seepage::BoxMeshSpec spec;
+  spec.size = {4.0, 2.0, 3.0};
+  spec.cells = {8, 4, 6};
+  spec.grading = {2.0, 1.0, 1.0};
+  spec.regions = {{"coal", true, {}, {}}, {"softened", false, {0.0, 0.0, 1.0}, {1.0, 2.0, 2.0}}};
+  const auto mesh = seepage::make_box_mesh(spec);
+  REQUIRE(mesh.region_names == std::vector<std::string>{"coal", "softened"});
+  int softened = 0;
+  for (std::size_t c = 0; c < mesh.num_cells(); ++c) {
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    for (const auto& x : mesh.corners(c)) centre += 0.125 * x;
+    const bool inside = centre.x() <= 1 && centre.z() >= 1 && centre.z() <= 2;
+    CHECK(mesh.cell_region[c] == (inside ? 1 : 0));
+    softened += inside;
+  }
+  CHECK(softened > 0);
+  spec.regions = {{"softened", false, {0.0, 0.0, 1.0}, {1.0, 2.0, 2.0}}};
+  CHECK_THROWS_WITH(seepage::make_box_mesh(spec), Catch::Contains("the cell centred at (") &&
+                                                      Catch::Contains(" m) lies in no region's box"));
+}
+
 TEST_CASE("the 3D sampler reads a linear field exactly inside the box and nothing outside it",
           "[seepage][3d][sampling]") {
   const Eigen::Vector3d a(2.0, -3.0, 0.5);
