@@ -57,7 +57,8 @@ class WindowLog {
 };
 
 // Refuses a run of more windows or MPM steps than any run may take.
-void check_run_length(scene::Table root, const coupling::CoupledSetup& setup) {
+template <int Dim>
+void check_run_length(scene::Table root, const coupling::CoupledSetup<Dim>& setup) {
   const double end_time = setup.header.end_time, window = setup.coupling.window;
   limits::refuse_count(*root.table("coupling", "", true), "window", end_time / window, limits::max_steps,
                        "coupling windows",
@@ -65,15 +66,20 @@ void check_run_length(scene::Table root, const coupling::CoupledSetup& setup) {
   mpm::check_run_length(*root.table("mpm", "", true), setup.solid, end_time);
 }
 
-int run(const RunOptions& options, scene::Document& doc) {
-  coupling::CoupledSetup setup = coupling::read_coupled_setup(doc.root());
+// The run of a coupled scene of dimension Dim (2: plane strain, 3: 3D).
+template <int Dim>
+int run_in(const RunOptions& options, scene::Document& doc) {
+  coupling::CoupledSetup<Dim> setup = coupling::read_coupled_setup<Dim>(doc.root());
   doc.reject_unused();
   check_run_length(doc.root(), setup);
   if (!finish_reading(options, doc)) return 0;
   const OutputFolder folder(options.output_directory(), "outburst", options.earlier_files());
   const auto& directory = folder.path();
-  const auto info = run_info("outburst", doc, "SI: m, s, kg, Pa; 2D plane strain, per metre of depth; MPM stresses "
-                                              "are effective (total = effective - alpha p I)");
+  const auto info = run_info("outburst", doc,
+                             fmt::format("SI: m, s, kg, Pa; {}; MPM stresses are effective (total = effective - alpha "
+                                         "p I)",
+                                         Dim == 2 ? "2D plane strain, per metre of depth" : "3D"));
+  const char* energy_unit = Dim == 2 ? "J/m" : "J";
   std::optional<checkpoint::Reader> restart;
   if (options.restart) restart.emplace(directory, info);
   // A checkpoint of the settling stage continues it; the run then starts as
@@ -82,7 +88,7 @@ int run(const RunOptions& options, scene::Document& doc) {
   const SceneHeader header = setup.header;
   const auto tracers = setup.solid.tracers;
   const mpm::Settling settling = setup.solid.settling;
-  coupling::CoupledModel model(std::move(setup), /*settle_later=*/true);
+  coupling::CoupledModel<Dim> model(std::move(setup), /*settle_later=*/true);
   if (settling.duration > 0 && !resume_run) {
     SettlingCheckpoints checkpoints(directory, info, header.checkpoint_interval, model, "model");
     if (restart) {
@@ -102,7 +108,7 @@ int run(const RunOptions& options, scene::Document& doc) {
                solid.particles().size(), cs.window);
 
   seepage::Output seepage_out(directory, info, seepage_solver, resume_run);
-  mpm::Output<2> solid_out(directory, info, tracers, resume_run);
+  mpm::Output<Dim> solid_out(directory, info, tracers, resume_run);
   WindowLog log(directory / "coupling.csv", cs.scheme.to_first, resume_run);
   seepage_out.series().list_with_others();
   solid_out.series().list_with_others();
@@ -110,12 +116,12 @@ int run(const RunOptions& options, scene::Document& doc) {
   const auto& coupler = model.coupling();
   // One coupling window at a time, cut short at an output time.
   struct Driver {
-    coupling::CoupledModel& model;
+    coupling::CoupledModel<Dim>& model;
     seepage::Output& seepage_out;
-    mpm::Output<2>& solid_out;
+    mpm::Output<Dim>& solid_out;
     WindowLog& log;
     long iterations = 0;
-    double kinetic = 0;  // after the last window [J/m]
+    double kinetic = 0;  // after the last window [J; J/m in 2D]
 
     double time() const { return model.coupling().time(); }
     LoopStep advance(double target) {
@@ -164,15 +170,20 @@ int run(const RunOptions& options, scene::Document& doc) {
   if (end == RunEnd::stopped) return report_stop(coupler.time(), directory);
   solid_out.finish();
   if (end == RunEnd::at_rest)
-    spdlog::info("the coal is at rest at t = {:.4g} s: kinetic energy {:.3g} J/m, below {:g} of its peak {:.3g} J/m",
-                 coupler.time(), solid.kinetic_energy(), *header.rest_fraction, loop.peak_kinetic_energy());
+    spdlog::info("the coal is at rest at t = {0:.4g} s: kinetic energy {1:.3g} {2}, below {3:g} of its peak {4:.3g} {2}",
+                 coupler.time(), solid.kinetic_energy(), energy_unit, *header.rest_fraction,
+                 loop.peak_kinetic_energy());
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-  spdlog::info("done: {} windows, {} sub-iterations, {} MPM steps, {:.3g} s wall; gas released {:.4g} m3/m, "
+  spdlog::info("done: {} windows, {} sub-iterations, {} MPM steps, {:.3g} s wall; gas released {:.4g} {}, "
                "{} particles left the grid",
                coupler.records().size(), driver.iterations, solid.steps(), wall, seepage_solver.balance().total_outflow(),
-               solid.removed_particles());
+               Dim == 2 ? "m3/m" : "m3", solid.removed_particles());
   spdlog::info("results: {}", std::filesystem::absolute(directory).string());
   return 0;
+}
+
+int run(const RunOptions& options, scene::Document& doc) {
+  return coupling::coupled_dimension(doc.root()) == 2 ? run_in<2>(options, doc) : run_in<3>(options, doc);
 }
 
 }  // namespace

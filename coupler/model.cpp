@@ -1,30 +1,50 @@
 #include "coupler/model.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numbers>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
 namespace outburst::coupling {
 
 namespace {
 
-double narrowest_cell(const seepage::Mesh& mesh) {
+// The shortest edge of any cell: of a quadrilateral's four, or a hexahedron's
+// twelve (corners 0-3 one face, 4-7 the opposite one, in Gmsh's order).
+template <int Dim>
+double narrowest_cell(const seepage::MeshOf<Dim>& mesh) {
+  constexpr std::array<std::array<int, 2>, 12> edges{
+      {{0, 1}, {1, 2}, {2, 3}, {3, 0}, {4, 5}, {5, 6}, {6, 7}, {7, 4}, {0, 4}, {1, 5}, {2, 6}, {3, 7}}};
   double narrowest = std::numeric_limits<double>::infinity();
   for (std::size_t c = 0; c < mesh.num_cells(); ++c) {
     const auto x = mesh.corners(c);
-    for (int k = 0; k < 4; ++k) narrowest = std::min(narrowest, (x[(k + 1) % 4] - x[k]).norm());
+    for (int k = 0; k < (Dim == 2 ? 4 : 12); ++k)
+      narrowest = std::min(narrowest, (x[edges[k][1]] - x[edges[k][0]]).norm());
   }
   return narrowest;
+}
+
+// The seepage mesh's bounding box.
+template <int Dim>
+std::pair<Eigen::Matrix<double, Dim, 1>, Eigen::Matrix<double, Dim, 1>> extent(const seepage::MeshOf<Dim>& mesh) {
+  auto lo = mesh.nodes.front(), hi = lo;
+  for (const auto& x : mesh.nodes) {
+    lo = lo.cwiseMin(x);
+    hi = hi.cwiseMax(x);
+  }
+  return {lo, hi};
 }
 
 // The smallest and largest draw of the moduli among material m's particles
 // (a heterogeneous material's; {1} for a uniform one): the softest and the
 // stiffest coal bound the regimes the window scheme meets.
-std::vector<double> modulus_scale_range(const mpm::Particles<2>& p, int m) {
+template <int Dim>
+std::vector<double> modulus_scale_range(const mpm::Particles<Dim>& p, int m) {
   double lo = std::numeric_limits<double>::infinity(), hi = 0;
   for (std::size_t i = 0; i < p.modulus_scale.size(); ++i)
     if (p.material[i] == m) lo = std::min(lo, p.modulus_scale[i]), hi = std::max(hi, p.modulus_scale[i]);
@@ -34,14 +54,10 @@ std::vector<double> modulus_scale_range(const mpm::Particles<2>& p, int m) {
 
 }  // namespace
 
-std::vector<stability::Regime> poroelastic_regimes(const CoupledSetup& s) {
+template <int Dim>
+std::vector<stability::Regime> poroelastic_regimes(const CoupledSetup<Dim>& s) {
   const double cell = narrowest_cell(s.seepage.mesh);
-  const auto& nodes = s.seepage.mesh.nodes;
-  Eigen::Vector2d lo = nodes.front(), hi = nodes.front();
-  for (const auto& x : nodes) {
-    lo = lo.cwiseMin(x);
-    hi = hi.cwiseMax(x);
-  }
+  const auto [lo, hi] = extent(s.seepage.mesh);
   std::vector<stability::Regime> regimes;
   const auto& p = s.solid.particles;
   for (std::size_t m = 0; m < s.solid.materials.size(); ++m) {
@@ -81,7 +97,8 @@ std::string describe(const stability::Window& w) {
 // the fixed-stress split unless the scene sets it); refuses a scheme the scene
 // names that cannot be stable at its window, naming the limit and the stable
 // alternative.
-void choose_window_pressure(const scene::Table& root, CoupledSetup& s) {
+template <int Dim>
+void choose_window_pressure(const scene::Table& root, CoupledSetup<Dim>& s) {
   auto& cs = s.coupling;
   const auto coupling = root.table("coupling", "", true);
   using Kind = SchemeSettings::Kind;
@@ -130,20 +147,30 @@ void choose_window_pressure(const scene::Table& root, CoupledSetup& s) {
 
 }  // namespace
 
-CoupledSetup read_coupled_scene(scene::Table root) {
-  CoupledSetup s;
+int coupled_dimension(scene::Table root) {
+  return mpm::scene_dimension(*root.table("mpm", "the material point solver", true));
+}
+
+template <int Dim>
+CoupledSetup<Dim> read_coupled_scene(scene::Table root) {
+  CoupledSetup<Dim> s;
   s.header = read_scene_header(root);
   require_solvers(root, s.header, {"seepage", "mpm"}, "outburst");
   if (s.header.solvers.size() != 2)
     root.table("scene", "", true)->fail("solvers", "outburst couples \"seepage\" and \"mpm\"; run seepage-fe or "
                                                    "mpm-solid for one alone");
-  s.seepage = seepage::read_setup(*root.table("seepage", "the gas seepage solver", true), false);
-  const auto mpm_table = root.table("mpm", "the material point solver", true);
-  // The coupling's mapping, averages and occupancy are plane ones so far.
-  if (mpm::scene_dimension(*mpm_table) != 2)
-    mpm_table->table("grid", "", true)->fail("size", "the coupled solver runs plane-strain scenes (a size of two "
-                                                     "lengths); a 3D MPM scene runs alone in mpm-solid");
-  s.solid = mpm::read_setup<2>(*mpm_table);
+  const auto seepage_table = root.table("seepage", "the gas seepage solver", true);
+  auto seepage_setup = seepage::read_any_setup(*seepage_table, false);
+  if (auto* same = std::get_if<seepage::SetupOf<Dim>>(&seepage_setup)) {
+    s.seepage = std::move(*same);
+  } else {
+    const auto mesh = seepage_table->table("mesh", "", true);
+    mesh->fail(mesh->has("file") ? "file" : "type",
+               fmt::format("a {} mesh, where the MPM grid is {} (its size has {} lengths): the two must be both "
+                           "plane or both 3D",
+                           Dim == 2 ? "3D" : "plane", Dim == 2 ? "plane" : "3D", Dim));
+  }
+  s.solid = mpm::read_setup<Dim>(*root.table("mpm", "the material point solver", true));
   const auto coupling = root.table("coupling", "the gas-solid coupling", true);
   s.coupling = read_coupling(*coupling);
   if (s.coupling.gas_solid.biot_storage && s.seepage.model.law != seepage::Law::linear)
@@ -151,14 +178,15 @@ CoupledSetup read_coupled_scene(scene::Table root) {
                                    "\"linear\" or drop the key");
   // Seepage cells off the MPM grid never hold coal: they would read as open
   // space and release their gas at once.
-  Eigen::Vector2d lo = s.seepage.mesh.nodes.front(), hi = lo;
-  for (const auto& x : s.seepage.mesh.nodes) lo = lo.cwiseMin(x), hi = hi.cwiseMax(x);
-  if (const auto past = mpm::overhang(s.solid.grid, lo, hi); !past.empty()) {
+  const auto [lo, hi] = extent(s.seepage.mesh);
+  if (const auto past = mpm::overhang<Dim>(s.solid.grid, lo, hi); !past.empty()) {
     const auto mesh = root.table("seepage", "", true)->table("mesh", "", true);
+    std::vector<std::string> spans;
+    for (int d = 0; d < Dim; ++d) spans.push_back(fmt::format("[{:g}, {:g}]", lo[d], hi[d]));
     mesh->fail(mesh->has("file") ? "file" : "origin",
-               fmt::format("the seepage mesh, [{:g}, {:g}] x [{:g}, {:g}] m, reaches {}: its cells there hold no coal "
-                           "and would read as open space",
-                           lo.x(), hi.x(), lo.y(), hi.y(), past));
+               fmt::format("the seepage mesh, {} m, reaches {}: its cells there hold no coal and would read as open "
+                           "space",
+                           fmt::join(spans, " x "), past));
   }
   // Every seepage cell the coal fills must read as coal: one without a
   // particle, or with fewer than open_below of its area in particles, reads as
@@ -170,7 +198,7 @@ CoupledSetup read_coupled_scene(scene::Table root) {
   for (double w : s.solid.particles.half_width) spacing = std::max(spacing, 2 * w * s.solid.grid.h);
   const double narrowest = narrowest_cell(s.seepage.mesh);
   const double per_row = std::floor(narrowest / spacing * (1 + 1e-9));
-  const double least_fill = std::pow(per_row * spacing / narrowest, 2);
+  const double least_fill = std::pow(per_row * spacing / narrowest, Dim);
   if (per_row < 1 || least_fill < s.coupling.gas_solid.open_below)
     root.table("mpm", "", true)->fail(
         "grid.cell_size",
@@ -182,22 +210,24 @@ CoupledSetup read_coupled_scene(scene::Table root) {
   return s;
 }
 
-CoupledSetup read_coupled_setup(scene::Table root) {
-  CoupledSetup s = read_coupled_scene(root);
+template <int Dim>
+CoupledSetup<Dim> read_coupled_setup(scene::Table root) {
+  CoupledSetup<Dim> s = read_coupled_scene<Dim>(root);
   if (s.coupling.gas_solid.biot_storage) choose_window_pressure(root, s);
   return s;
 }
 
-CoupledModel::CoupledModel(CoupledSetup setup, bool settle_later) : setup_(std::move(setup)) {
+template <int Dim>
+CoupledModel<Dim>::CoupledModel(CoupledSetup<Dim> setup, bool settle_later) : setup_(std::move(setup)) {
   auto& seep = setup_.seepage;
   auto& solid = setup_.solid;
   const CouplingSetup& cs = setup_.coupling;
   // The solver keeps the one copy of the mesh; the mapping reads it through
   // the solver's sampler.
-  seepage_ = std::make_unique<seepage::Solver>(std::move(seep.mesh), seep.model, seep.settings);
-  solid_ = std::make_unique<mpm::Solver<2>>(solid.grid, std::move(solid.materials), std::move(solid.particles),
-                                         solid.settings);
-  mapping_ = std::make_unique<MeshMapping<2>>(seepage_->sampler());
+  seepage_ = std::make_unique<seepage::SolverOf<Dim>>(std::move(seep.mesh), seep.model, seep.settings);
+  solid_ = std::make_unique<mpm::Solver<Dim>>(solid.grid, std::move(solid.materials), std::move(solid.particles),
+                                              solid.settings);
+  mapping_ = std::make_unique<MeshMapping<Dim>>(seepage_->sampler());
   GasSolidSettings gas_solid = cs.gas_solid;
   if (cs.fixed_stress_split.value_or(false)) {
     // The softest coal's drained bulk modulus: the split's stabilisation must
@@ -211,8 +241,8 @@ CoupledModel::CoupledModel(CoupledSetup setup, bool settle_later) : setup_(std::
     gas_solid.fixed_stress = gas_solid.biot * gas_solid.biot / bulk;
   }
   gas_solid.window_pressure = cs.window_pressure.value_or(stability::Pressure::ramp);
-  seepage_side_ = std::make_unique<SeepageParticipant<2>>(*seepage_, gas_solid);
-  solid_side_ = std::make_unique<SolidParticipant<2>>(*solid_, *mapping_, gas_solid, seepage_side_->read(std::string(pressure_field)),
+  seepage_side_ = std::make_unique<SeepageParticipant<Dim>>(*seepage_, gas_solid);
+  solid_side_ = std::make_unique<SolidParticipant<Dim>>(*solid_, *mapping_, gas_solid, seepage_side_->read(std::string(pressure_field)),
                                                    solid.fixed_time_step);
   if (cs.total_initial_stress) {
     std::vector<double> cell_pressure;
@@ -225,12 +255,14 @@ CoupledModel::CoupledModel(CoupledSetup setup, bool settle_later) : setup_(std::
 }
 
 // The gas pressure starts uniform in each region: no gas force while settling.
-bool CoupledModel::settle(const std::function<bool()>& pause) {
+template <int Dim>
+bool CoupledModel<Dim>::settle(const std::function<bool()>& pause) {
   settled_ = solid_->settle(setup_.solid.settling, setup_.solid.fixed_time_step, pause);
   return settled_.has_value();
 }
 
-void CoupledModel::save(checkpoint::Out out) const {
+template <int Dim>
+void CoupledModel<Dim>::save(checkpoint::Out out) const {
   seepage_->save(out.group("seepage"));
   solid_->save(out.group("mpm"));
   seepage_side_->save_between_windows(out.group("seepage_side"));
@@ -238,7 +270,8 @@ void CoupledModel::save(checkpoint::Out out) const {
   coupling_->save(out.group("coupling"));
 }
 
-void CoupledModel::load(const checkpoint::In& in) {
+template <int Dim>
+void CoupledModel<Dim>::load(const checkpoint::In& in) {
   seepage_->load(in.group("seepage"));
   solid_->load(in.group("mpm"));
   seepage_side_->load_between_windows(in.group("seepage_side"));
@@ -246,8 +279,18 @@ void CoupledModel::load(const checkpoint::In& in) {
   coupling_->load(in.group("coupling"));
 }
 
-const WindowRecord& CoupledModel::advance(double limit) {
+template <int Dim>
+const WindowRecord& CoupledModel<Dim>::advance(double limit) {
   return coupling_->advance(std::min(setup_.coupling.window, limit - coupling_->time()));
 }
+
+template CoupledSetup<2> read_coupled_scene<2>(scene::Table);
+template CoupledSetup<3> read_coupled_scene<3>(scene::Table);
+template CoupledSetup<2> read_coupled_setup<2>(scene::Table);
+template CoupledSetup<3> read_coupled_setup<3>(scene::Table);
+template std::vector<stability::Regime> poroelastic_regimes(const CoupledSetup<2>&);
+template std::vector<stability::Regime> poroelastic_regimes(const CoupledSetup<3>&);
+template class CoupledModel<2>;
+template class CoupledModel<3>;
 
 }  // namespace outburst::coupling

@@ -12,8 +12,9 @@ using namespace outburst;
 
 namespace {
 
-int run(const RunOptions& options, scene::Document& doc) {
-  const coupling::CoupledSetup setup = coupling::read_coupled_scene(doc.root());
+template <int Dim>
+int run_in(const RunOptions& options, scene::Document& doc) {
+  const coupling::CoupledSetup<Dim> setup = coupling::read_coupled_scene<Dim>(doc.root());
   if (!finish_reading(options, doc)) return 0;
   if (!setup.coupling.gas_solid.biot_storage)
     throw scene::Error(fmt::format("{}: the stability analysis is of the Biot storage coupling: set "
@@ -38,6 +39,10 @@ int run(const RunOptions& options, scene::Document& doc) {
                                 .c_str());
       }
   return 0;
+}
+
+int run(const RunOptions& options, scene::Document& doc) {
+  return coupling::coupled_dimension(doc.root()) == 2 ? run_in<2>(options, doc) : run_in<3>(options, doc);
 }
 
 }  // namespace

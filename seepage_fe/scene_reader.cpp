@@ -351,14 +351,6 @@ std::variant<Setup, Setup3> read_any_setup(const scene::Table& s, bool own_time_
       input);
 }
 
-Setup read_setup(const scene::Table& s, bool own_time_steps) {
-  auto setup = read_any_setup(s, own_time_steps);
-  if (auto* plane = std::get_if<Setup>(&setup)) return std::move(*plane);
-  const auto mesh = s.table("mesh", "the finite element mesh", true);
-  mesh->fail(mesh->has("file") ? "file" : "type",
-             "a 3D mesh (hexahedra), where this program couples the seepage to a plane solid: give a plane mesh "
-             "(\"structured\", or a Gmsh file of quadrangles); seepage-fe runs 3D scenes on their own");
-}
 
 }  // namespace outburst::seepage
 

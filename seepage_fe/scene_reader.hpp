@@ -32,9 +32,6 @@ using Setup3 = SetupOf<3>;
 // own_time_steps: read time_step and its growth (false when a coupling window
 // sets the steps, so a coupled scene does not carry keys nothing uses).
 std::variant<Setup, Setup3> read_any_setup(const scene::Table& seepage, bool own_time_steps = true);
-// A plane scene (the coupled programs': their solid is plane); a 3D mesh is
-// refused at seepage.mesh.
-Setup read_setup(const scene::Table& seepage, bool own_time_steps = true);
 
 // Steps a run to end_time takes under this control (output times aside).
 double estimated_steps(const TimeStepControl& steps, double end_time);

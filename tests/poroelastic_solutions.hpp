@@ -94,7 +94,7 @@ struct Mandel {
 };
 
 // Mandel: the mean seepage pressure on the specimen's centre line x = 0 [Pa].
-inline double centre_pressure(coupling::CoupledModel& model) {
+inline double centre_pressure(coupling::CoupledModel<2>& model) {
   const auto p = model.seepage().nodal_pressure();
   const auto& mesh = model.mapping().mesh();
   double centre = 0;

@@ -16,7 +16,8 @@ using namespace outburst::testing;
 
 namespace {
 
-double mean_iterations(const coupling::CoupledModel& model) {
+template <int Dim>
+double mean_iterations(const coupling::CoupledModel<Dim>& model) {
   double sum = 0;
   for (const auto& w : model.coupling().records()) sum += w.iterations;
   return sum / static_cast<double>(model.coupling().records().size());
@@ -29,10 +30,13 @@ struct Result {
   double seconds = 0;
 };
 
-// Runs cases/terzaghi with the overrides, checking at t = 0.1 ... 0.5 s.
+// Runs cases/terzaghi (in 3D cases/terzaghi_3d) with the overrides, checking
+// at t = 0.1 ... 0.5 s.
+template <int Dim = 2>
 Result run(const std::vector<std::string>& overrides) {
-  auto doc = scene::Document::load(std::string(OUTBURST_SOURCE_DIR) + "/cases/terzaghi/terzaghi.toml", overrides);
-  coupling::CoupledModel model(coupling::read_coupled_setup(doc->root()));
+  const std::string scene = Dim == 2 ? "terzaghi/terzaghi.toml" : "terzaghi_3d/terzaghi_3d.toml";
+  auto doc = scene::Document::load(std::string(OUTBURST_SOURCE_DIR) + "/cases/" + scene, overrides);
+  coupling::CoupledModel model(coupling::read_coupled_setup<Dim>(doc->root()));
   doc->reject_unused();
   // The scene's values (see its header).
   const double e = 1e7, nu = 0.25, q = 1e4, s = 1e-7, k_mu = 1.833e-10 / 1e-3, alpha = 1.0, height = 1.0;
@@ -99,6 +103,31 @@ TEST_CASE("Terzaghi consolidation: pore pressure and settlement follow the analy
   CHECK(results[4].iterations < results[3].iterations);
   // The implicit answer settles as the window shrinks.
   CHECK(results[6].pressure_error <= results[5].pressure_error);
+}
+
+TEST_CASE("Terzaghi in a 3D column: pore pressure and settlement follow the analytic series as in the plane one",
+          "[coupler][poroelastic][terzaghi][3d]") {
+  struct Case {
+    const char* label;
+    std::vector<std::string> overrides;
+  };
+  const std::vector<Case> cases{{"implicit IQN-ILS (scene)", {}},
+                                {"explicit, fixed stress", {"coupling.scheme=\"explicit\"", "coupling.fixed_stress=true"}}};
+  std::printf("\nTerzaghi, plane column against 3D column (window 5 ms, t = 0.1-0.5 s):\n%-24s %-6s %10s %12s %12s\n",
+              "scheme", "column", "p RMS/p0", "settlement", "its/window");
+  for (const auto& c : cases) {
+    const Result plane = run<2>(c.overrides), solid = run<3>(c.overrides);
+    for (const auto& [column, r] : {std::pair{"plane", plane}, std::pair{"3D", solid}})
+      std::printf("%-24s %-6s %10.4f %11.2f%% %12.2f\n", c.label, column, r.pressure_error,
+                  100 * r.settlement_error, r.iterations);
+    INFO(c.label);
+    // The same discretisation along the column, a column of cells across it:
+    // the 3D answer is the plane one's, to the coupling's tolerance.
+    CHECK(solid.pressure_error < 1.05 * plane.pressure_error + 1e-3);
+    CHECK(solid.settlement_error < 1.05 * plane.settlement_error + 1e-3);
+    CHECK(solid.pressure_error < 0.03);
+    CHECK(solid.settlement_error < 0.03);
+  }
 }
 
 TEST_CASE("Terzaghi on a ten times stiffer column: Aitken and IQN-ILS beat constant relaxation, and the "

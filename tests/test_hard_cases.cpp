@@ -49,7 +49,7 @@ Outcome run(const std::string& scene, const std::vector<std::string>& overrides,
             Error error, Watch watch) {
   auto doc = scene::Document::load(std::string(OUTBURST_SOURCE_DIR) + "/cases/" + scene, overrides);
   Outcome o;
-  std::optional<coupling::CoupledSetup> setup;
+  std::optional<coupling::CoupledSetup<2>> setup;
   try {
     setup = coupling::read_coupled_setup(doc->root());
   } catch (const scene::Refusal& e) {
@@ -93,13 +93,13 @@ Outcome terzaghi(double storage, std::vector<std::string> overrides, double end)
   std::vector<double> checks;
   for (double t = 0.05; t < end + 1e-9; t += 0.05) checks.push_back(t);
   return run("terzaghi/terzaghi.toml", overrides, checks,
-             [&](coupling::CoupledModel& model, double t) {
+             [&](coupling::CoupledModel<2>& model, double t) {
                const auto& mesh = model.mapping().mesh();
                std::vector<double> expected;
                for (const auto& x : mesh.nodes) expected.push_back(exact.pressure(height - x.y(), t));
                return rms(model.seepage().nodal_pressure(), expected) / exact.p0;
              },
-             [](coupling::CoupledModel&) {});
+             [](coupling::CoupledModel<2>&) {});
 }
 
 // cases/mandel (the quarter specimen, 1 m x 1 m) with the overrides.
@@ -111,13 +111,13 @@ Outcome mandel(const std::vector<std::string>& overrides, double end) {
   double peak = 0;
   Outcome o = run(
       "mandel/mandel.toml", overrides, checks,
-      [&](coupling::CoupledModel& model, double t) {
+      [&](coupling::CoupledModel<2>& model, double t) {
         const auto& mesh = model.mapping().mesh();
         std::vector<double> expected;
         for (const auto& x : mesh.nodes) expected.push_back(exact.pressure(x.x(), t));
         return rms(model.seepage().nodal_pressure(), expected) / p0;
       },
-      [&](coupling::CoupledModel& model) {
+      [&](coupling::CoupledModel<2>& model) {
         if (model.coupling().time() < 0.025 - 1e-12) return;  // still ringing from the sudden load
         peak = std::max(peak, centre_pressure(model) / p0);
       });

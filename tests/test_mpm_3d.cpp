@@ -114,7 +114,10 @@ std::vector<std::unique_ptr<Material<Dim>>> model(Model m) {
       v.push_back(std::make_unique<DruckerPrager<Dim>>("m", e, 2e3, 0.5, 0.1, DruckerPragerFit::Kind::outer));
       break;
     case Model::damage:
-      v.push_back(std::make_unique<ElasticDamage<Dim>>("m", e, DamageParameters{.cohesion = 2e4, .friction_angle = 0.5, .tensile_strength = 3e3, .residual_ratio = 0.1, .ultimate_ratio = 5}));
+      v.push_back(std::make_unique<ElasticDamage<Dim>>(
+          "m", e,
+          DamageParameters{.cohesion = 2e4, .friction_angle = 0.5, .tensile_strength = 3e3, .residual_ratio = 0.1,
+                           .ultimate_ratio = 5, .fracture_energy = std::nullopt}));
       break;
   }
   return v;

@@ -19,7 +19,7 @@ void read_seepage_scene(const std::string& text, const std::vector<std::string>&
   auto root = doc->root();
   const auto header = read_scene_header(root);
   require_solvers(root, header, {"seepage"}, "seepage-fe");
-  seepage::read_setup(*root.table("seepage", "", true));
+  seepage::read_any_setup(*root.table("seepage", "", true));
   doc->reject_unused();
 }
 
@@ -151,7 +151,7 @@ TEST_CASE("explain lists every key read, marking defaults", "[scene]") {
   auto doc = scene::Document::parse(valid, "valid.toml");
   auto root = doc->root();
   read_scene_header(root);
-  seepage::read_setup(*root.table("seepage", "", true));
+  seepage::read_any_setup(*root.table("seepage", "", true));
   const std::string text = doc->explain();
   CHECK_THAT(text, Catch::Contains("seepage.time_scheme = \"bdf2\""));
   CHECK_THAT(text, Catch::Contains("(default)"));
@@ -162,7 +162,7 @@ TEST_CASE("explain as JSON gives each key with what it expects, its choices and 
   auto doc = scene::Document::parse(valid, "valid.toml");
   auto root = doc->root();
   read_scene_header(root);
-  seepage::read_setup(*root.table("seepage", "", true));
+  seepage::read_any_setup(*root.table("seepage", "", true));
   const std::string json = doc->explain_json();
   CHECK_THAT(json, Catch::StartsWith("{"));
   CHECK_THAT(json, Catch::Contains(R"("key" : "seepage.time_scheme")"));
