@@ -5,13 +5,14 @@ largest energy term.
 
 usage: energy_budget.py DIR [--most-open 0.01] [--most-step 0.1]
 
-The largest term is the largest change any term of the account shows over the
-run (kinetic, strain and gravitational energy from their first values; the
-dissipated, transferred and external ones from zero), as mpm::EnergyAudit
-measures it. The balance error (total energy now minus at the start) above
-most_open of it at any output means energy the books do not hold; the time
-step's own error (integration) above most_step, a step too close to the
-stable one or a blow-up.
+The energies are per metre of depth (_J_per_m) in a plane run, in joules (_J)
+in a 3D one. The largest term is the largest change any term of the account
+shows over the run (kinetic, strain and gravitational energy from their first
+values; the dissipated, transferred and external ones from zero), as
+mpm::EnergyAudit measures it. The balance error (total energy now minus at
+the start) above most_open of it at any output means energy the books do not
+hold; the time step's own error (integration) above most_step, a step too
+close to the stable one or a blow-up.
 """
 import argparse
 import csv
@@ -41,16 +42,19 @@ def main():
         if bad:
             sys.exit(f"{path}: t = {r['time_s']:g} s: non-finite {', '.join(bad)}")
     first = rows[0]
+    unit = "J_per_m" if "kinetic_J_per_m" in first else "J"
+    shown = unit.replace("_per_", "/")
+    e = lambda r, term: r[f"{term}_{unit}"]
     stored = {"kinetic", "strain", "gravity"}
-    largest = max(abs(r[f"{t}_J_per_m"] - (first[f"{t}_J_per_m"] if t in stored else 0)) for r in rows for t in TERMS)
-    worst = max(rows, key=lambda r: abs(r["balance_error_J_per_m"]))
-    share = abs(worst["balance_error_J_per_m"]) / max(largest, 1e-300)
-    step = max(abs(r["integration_J_per_m"] - first["integration_J_per_m"]) for r in rows) / max(largest, 1e-300)
+    largest = max(abs(e(r, t) - (e(first, t) if t in stored else 0)) for r in rows for t in TERMS)
+    worst = max(rows, key=lambda r: abs(e(r, "balance_error")))
+    share = abs(e(worst, "balance_error")) / max(largest, 1e-300)
+    step = max(abs(e(r, "integration") - e(first, "integration")) for r in rows) / max(largest, 1e-300)
     last = rows[-1]
-    print(f"{path}: {len(rows)} outputs to t = {last['time_s']:g} s; largest term {largest:.4g} J/m; balance error at "
-          f"most {worst['balance_error_J_per_m']:+.4g} J/m ({share:.2%} of it, t = {worst['time_s']:g} s); "
-          f"time step's own error at most {step:.2%}; at the end transfer {last['transfer_J_per_m']:.4g} J/m, "
-          f"time step {last['integration_J_per_m']:.4g} J/m, walls {last['walls_J_per_m']:.4g} J/m")
+    print(f"{path}: {len(rows)} outputs to t = {last['time_s']:g} s; largest term {largest:.4g} {shown}; balance "
+          f"error at most {e(worst, 'balance_error'):+.4g} {shown} ({share:.2%} of it, t = {worst['time_s']:g} s); "
+          f"time step's own error at most {step:.2%}; at the end transfer {e(last, 'transfer'):.4g} {shown}, "
+          f"time step {e(last, 'integration'):.4g} {shown}, walls {e(last, 'walls'):.4g} {shown}")
     if share > args.most_open:
         sys.exit(f"energy books open by {share:.2%} of the largest term (at most {args.most_open:.2%})")
     if step > args.most_step:
