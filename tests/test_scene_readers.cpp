@@ -1,7 +1,8 @@
 // What the programs' scene readers make of whole scenes: every shipped scene
-// is valid (read fully, no unknown keys), and the coupled scene's checks
-// across its solvers (cells read as open space, meshes past the grid, the
-// fields the solid sends). The scene file format itself: test_scene_format.cpp.
+// is valid (read fully, in its own dimension, no unknown keys), and the
+// coupled scene's checks across its solvers (cells read as open space, meshes
+// past the grid, the fields the solid sends). The scene file format itself:
+// test_scene_format.cpp.
 #include <catch2/catch.hpp>
 
 #include <filesystem>
@@ -28,7 +29,13 @@ TEST_CASE("shipped scenes are valid", "[scene][cases]") {
     const bool coupled = header.solvers.size() == 2;
     for (const auto& solver : header.solvers) {
       if (solver == "seepage") REQUIRE_NOTHROW(seepage::read_setup(*root.table("seepage", "", true), !coupled));
-      if (solver == "mpm") REQUIRE_NOTHROW(mpm::read_setup<2>(*root.table("mpm", "", true)));
+      if (solver == "mpm") {
+        const auto mpm = root.table("mpm", "", true);
+        if (mpm::scene_dimension(*mpm) == 2)
+          REQUIRE_NOTHROW(mpm::read_setup<2>(*mpm));
+        else
+          REQUIRE_NOTHROW(mpm::read_setup<3>(*mpm));
+      }
     }
     if (coupled) REQUIRE_NOTHROW(coupling::read_coupling(*root.table("coupling", "", true)));
     REQUIRE_NOTHROW(doc->reject_unused());
