@@ -59,20 +59,27 @@ struct Principal<2> {
 
 template <>
 struct Principal<3> {
+  Mat<3> matrix;
   Vec<3> values;  // ascending
-  Mat<3> axes;    // the columns
-  explicit Principal(const Mat<3>& s) {
-    // The closed form for 3 x 3: one per particle and step, where the
-    // iterative solver costs several times more.
+  Mat<3> axes;    // the columns; only where the values straddle zero
+  explicit Principal(const Mat<3>& s) : matrix(s) {
+    // A state all in tension, or all in compression, cracks without its
+    // axes. Where they are needed, the iterative solver's: the closed form's
+    // are not orthogonal where two principal values agree (by 7e-7 under
+    // uniaxial strain, its two lateral stresses equal), and the stress
+    // recomposed from them is off by as much.
     Eigen::SelfAdjointEigenSolver<Mat<3>> solver;
-    solver.computeDirect(s);
+    solver.computeDirect(s, Eigen::EigenvaluesOnly);
     values = solver.eigenvalues();
-    axes = solver.eigenvectors();
+    if (values[0] < 0 && values[2] > 0) {
+      solver.compute(s);
+      values = solver.eigenvalues();
+      axes = solver.eigenvectors();
+    }
   }
-  double largest() const { return values[2]; }
-  double smallest() const { return values[0]; }
-  double sum() const { return values.sum(); }
   Mat<3> cracked(double factor) const {
+    if (values[0] >= 0) return factor * matrix;
+    if (values[2] <= 0) return matrix;
     Vec<3> v;
     for (int k = 0; k < 3; ++k) v[k] = crack(values[k], factor);
     return axes * v.asDiagonal() * axes.transpose();
@@ -289,8 +296,7 @@ Dissipation ElasticDamage<Dim>::settle(Particles<Dim>& p, int i, double d) const
   p.damage[i] = d;
   // The stress acting: open cracks carry no share of tension. Intact 3D coal
   // (d = 0, and no less before) acts with its undamaged stress as it is: a
-  // decomposition and recomposition would move it by roundoff every step,
-  // and the closed form's axes by more where principal values nearly agree.
+  // decomposition and recomposition would move it by roundoff every step.
   const bool intact = Dim == 3 && d == 0;
   std::optional<Principal<Dim>> pr;
   if (!intact) pr.emplace(effective);

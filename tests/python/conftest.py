@@ -1,5 +1,6 @@
-"""Options of the Python tests: where the build is (for the programs) and a
-short outburst run to report on; CTest passes both (tests/CMakeLists.txt)."""
+"""Options of the Python tests: where the build is (for the programs), a
+short outburst run to report on and a coarse run of the 3D granular collapse
+to measure; CTest passes them (tests/CMakeLists.txt)."""
 import os
 
 import pytest
@@ -10,6 +11,8 @@ REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 def pytest_addoption(parser):
     parser.addoption("--build", help="the build folder holding the programs (default: build/)")
     parser.addoption("--outburst-run", help="output folder of a short run of cases/outburst/outburst.toml")
+    parser.addoption("--collapse-3d-run",
+                     help="output folder of a run of cases/granular_collapse_3d/granular_collapse_3d.toml")
 
 
 @pytest.fixture
@@ -30,11 +33,20 @@ def build(request):
     return path
 
 
+def given_run(request, option, what):
+    path = request.config.getoption(option)
+    if path is None:
+        pytest.skip(f"no {what} (pass {option})")
+    if not os.path.isdir(path):
+        pytest.fail(f"{option} {path}: no such folder")
+    return path
+
+
 @pytest.fixture
 def outburst_run(request):
-    path = request.config.getoption("--outburst-run")
-    if path is None:
-        pytest.skip("no outburst run to report on (pass --outburst-run)")
-    if not os.path.isdir(path):
-        pytest.fail(f"--outburst-run {path}: no such folder")
-    return path
+    return given_run(request, "--outburst-run", "outburst run to report on")
+
+
+@pytest.fixture
+def collapse_3d_run(request):
+    return given_run(request, "--collapse-3d-run", "3D granular collapse run to measure")
