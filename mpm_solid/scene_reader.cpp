@@ -202,14 +202,15 @@ std::optional<std::pair<std::size_t, std::size_t>> crossing_edges(const std::vec
 template <int Dim>
 struct BodyShape {
   Vec<Dim> lo, hi;
-  std::vector<Vec<2>> polygon;           // 2D; empty: the box
-  std::optional<double> radius;          // 3D: a sphere centred in the box
+  std::vector<Vec<2>> polygon;  // 2D; empty: the box
+  std::optional<double> radius;  // 3D: the sphere's about `centre`
+  Vec<Dim> centre = Vec<Dim>::Zero();
   bool holds(const Vec<Dim>& x) const {
     if (!((x.array() >= lo.array()).all() && (x.array() <= hi.array()).all())) return false;
     if constexpr (Dim == 2)
       return polygon.empty() || inside_polygon(polygon, x);
     else
-      return !radius || (x - 0.5 * (lo + hi)).squaredNorm() <= *radius * *radius;
+      return !radius || (x - centre).squaredNorm() <= *radius * *radius;
   }
 };
 
@@ -405,12 +406,19 @@ BodyShape<Dim> read_body_shape(const scene::Table& b) {
     }
   } else if (b.has("radius")) {
     if constexpr (Dim == 2) b.fail("radius", "a sphere is a 3D body; a 2D body is a box or a polygon");
-    const Vec<Dim> centre =
-        to_vec<Dim>(b.quantity_vector({"centre", "centre of a spherical body"}, units::length, Dim));
+    shape.centre = to_vec<Dim>(b.quantity_vector({"centre", "centre of a spherical body"}, units::length, Dim));
     const double radius = b.quantity({"radius", "radius of a spherical body", "", Range::positive()}, units::length);
     shape.radius = radius;
-    shape.lo = centre.array() - radius;
-    shape.hi = centre.array() + radius;
+    shape.lo = shape.centre.array() - radius;
+    shape.hi = shape.centre.array() + radius;
+    // A part of the sphere: an octant or a half beside symmetry walls.
+    if (b.has("box_min") || b.has("box_max")) {
+      const auto [lo, hi] = read_box<Dim>(b, "the box the sphere is cut to (a part of it beside symmetry walls)");
+      shape.lo = shape.lo.cwiseMax(lo);
+      shape.hi = shape.hi.cwiseMin(hi);
+      if (!(shape.hi.array() > shape.lo.array()).all())
+        b.fail("box_min", "the box holds no part of the sphere");
+    }
   } else {
     std::tie(shape.lo, shape.hi) = read_box<Dim>(b, "a rectangular body");
   }
@@ -457,7 +465,7 @@ void read_bodies(const scene::Table& s, Setup<Dim>& setup, const std::vector<std
                                                                    : "n for n x n x n particles per cell",
                                     "2", Range::between(1, 8)});
     BodyShape<Dim> shape = read_body_shape<Dim>(b);
-    const char* shape_key = b.has("polygon") ? "polygon" : b.has("radius") ? "centre" : "box_min";
+    const char* shape_key = b.has("polygon") ? "polygon" : b.has("radius") && !b.has("box_min") ? "centre" : "box_min";
     if (const auto past = overhang(gr, shape.lo, shape.hi); !past.empty())
       b.fail(overhang(gr, shape.lo, shape.lo).empty() && shape_key == std::string_view("box_min") ? "box_max"
                                                                                                   : shape_key,

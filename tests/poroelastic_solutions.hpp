@@ -1,6 +1,7 @@
 #pragma once
 // Analytic solutions of the poroelastic checks: Terzaghi's consolidation
-// (cases/terzaghi) and Mandel's problem (cases/mandel).
+// (cases/terzaghi), Mandel's problem (cases/mandel) and Cryer's sphere
+// (cases/cryer).
 
 #include <cmath>
 #include <vector>
@@ -90,6 +91,47 @@ struct Mandel {
     for (double r : roots)
       sum += std::sin(r) * std::cos(r) / (r - std::sin(r) * std::cos(r)) * std::exp(-r * r * c * t / (a * a));
     return -b * force / (shear * a) * (-(1 - nu) / 2 + (1 - nu_u) * sum);
+  }
+};
+
+// Cryer's sphere (Verruijt 2016, Theory and problems of poroelasticity, as
+// the Beaver code's documentation gives it): the pressure at the centre of a
+// sphere of radius a whose surface drains from t = 0, over the undrained p0,
+//   eta sum (sin x_j - x_j) / ((eta - 1) sin x_j + eta x_j cos x_j / 2)
+//       exp(-x_j^2 c_v t / a^2),
+// x_j the positive roots of (1 - eta x^2 / 2) tan x = x, with
+// eta = (1 - nu) / (1 - 2 nu) (1 + K S / alpha^2) and
+// c_v = (k / mu) (K + 4 G / 3) / (alpha^2 + S (K + 4 G / 3)).
+struct Cryer {
+  double a, eta, cv;
+  std::vector<double> roots;
+
+  Cryer(double radius, double e, double nu, double storage, double alpha, double mobility) : a(radius) {
+    const double bulk = e / (3 * (1 - 2 * nu)), shear = e / (2 * (1 + nu)), oedometric = bulk + 4 * shear / 3;
+    eta = (1 - nu) / (1 - 2 * nu) * (1 + bulk * storage / (alpha * alpha));
+    cv = mobility * oedometric / (alpha * alpha + storage * oedometric);
+    // (1 - eta x^2 / 2) sin x - x cos x has no poles: its sign changes
+    // bracket the roots, each refined by bisection.
+    const auto f = [this](double x) { return (1 - eta * x * x / 2) * std::sin(x) - x * std::cos(x); };
+    const double step = 0.01;
+    for (double lo = step; roots.size() < 400; lo += step) {
+      double left = lo, right = lo + step;
+      if ((f(left) < 0) == (f(right) < 0)) continue;
+      const bool rising = f(left) < 0;
+      for (int it = 0; it < 100; ++it) {
+        const double mid = 0.5 * (left + right);
+        ((f(mid) < 0) == rising ? left : right) = mid;
+      }
+      roots.push_back(0.5 * (left + right));
+    }
+  }
+  // p(0, t) / p0.
+  double centre(double t) const {
+    double sum = 0;
+    for (double x : roots)
+      sum += (std::sin(x) - x) / ((eta - 1) * std::sin(x) + eta * x * std::cos(x) / 2) *
+             std::exp(-x * x * cv * t / (a * a));
+    return eta * sum;
   }
 };
 

@@ -1,0 +1,1 @@
+"""Cryer's sphere: its measure and its resolution study."""
