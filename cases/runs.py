@@ -1,5 +1,6 @@
 """Running the programs for the studies, sensitivity runs and ensembles, and
 writing their rows."""
+import concurrent.futures
 import csv
 import os
 import subprocess
@@ -27,6 +28,23 @@ def run_one(program, scene, overrides, directory, threads):
         if done.returncode == REFUSED:
             note = "refused: " + note.split("] ")[-1]
     return wall, note
+
+
+def run_side_by_side(program, scene, runs, jobs):
+    """Runs the scene with each (overrides, directory) of `runs`, one thread
+    each, `jobs` side by side; returns their wall times by directory. A run
+    that fails stops the study with its last message."""
+    walls = {}
+    with concurrent.futures.ThreadPoolExecutor(max_workers=jobs) as pool:
+        futures = {pool.submit(run_one, program, scene, overrides, directory, 1): directory
+                   for overrides, directory in runs}
+        for done in concurrent.futures.as_completed(futures):
+            wall, note = done.result()
+            if note:
+                raise SystemExit(f"{futures[done]}: {note}")
+            walls[futures[done]] = wall
+            print(f"  {futures[done]}: {wall:.0f} s", flush=True)
+    return walls
 
 
 def write_rows(path, rows):

@@ -7,6 +7,7 @@
 #include <random>
 
 #include "coupler/gas_solid.hpp"
+#include "coupling_fixtures.hpp"
 #include "mpm_fixtures.hpp"
 #include "seepage_fixtures.hpp"
 
@@ -102,17 +103,9 @@ TEST_CASE("3D one-way: a column under a linear gas pressure settles to the analy
   mpm::Solver<3> solid(gr, elastic<3>({rho, E, nu}), block<3>(gr, mpm::Vec<3>::Zero(), mpm::Vec<3>(1, H, 1), rho, 2),
                        s);
 
-  GasSolidSettings gs;
-  gs.biot = alpha;
-  gs.permeability_coupling = false;
-  SeepageParticipant seepage_side(seep, gs);
-  const MeshMapping map(seep.sampler());
-  SolidParticipant solid_side(solid, map, gs, seepage_side.read("pressure"), std::nullopt);
-  SchemeSettings scheme;
-  scheme.kind = SchemeSettings::Kind::one_way;
-  scheme.to_second = {"pressure"};
-  Coupling c(seepage_side, solid_side, scheme);
-  while (c.time() < 0.5) c.advance(0.005);
+  OneWay<3> one_way(seep, solid, alpha);
+  one_way.run_to(0.5, 0.005);
+  const auto& map = one_way.map;
 
   const double f = alpha * p0 / H, M = E * (1 - nu) / ((1 + nu) * (1 - 2 * nu));
   const auto& p = solid.particles();
@@ -134,9 +127,9 @@ TEST_CASE("3D one-way: a column under a linear gas pressure settles to the analy
   CHECK(displacement_error < 0.01 * top_u);
   // With the permeability coupling the solid sends its cells' mean stress,
   // six components (xx, yy, zz, yz, xz, xy), which conserve sum V sigma.
-  GasSolidSettings with_stress = gs;
+  GasSolidSettings with_stress = one_way.settings;
   with_stress.permeability_coupling = true;
-  const SolidParticipant probe(solid, map, with_stress, seepage_side.read("pressure"), std::nullopt);
+  const SolidParticipant probe(solid, map, with_stress, one_way.seepage_side.read("pressure"), std::nullopt);
   const Eigen::VectorXd mean = probe.read("stress"), fraction = probe.read("occupancy");
   const auto nc = static_cast<Eigen::Index>(seep.mesh().num_cells());
   REQUIRE(mean.size() == 6 * nc);

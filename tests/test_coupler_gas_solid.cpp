@@ -6,6 +6,7 @@
 #include <random>
 
 #include "coupler/gas_solid.hpp"
+#include "coupling_fixtures.hpp"
 #include "mpm_fixtures.hpp"
 #include "seepage_fixtures.hpp"
 
@@ -102,17 +103,8 @@ TEST_CASE("one-way: a column under a linear gas pressure settles to the analytic
              mpm::Wall{mpm::Wall::Type::fixed}, mpm::Wall{}};
   mpm::Solver<2> solid(gr, elastic({rho, E, nu}), block(gr, {0, 0}, {1, H}, rho, 2), s);
 
-  GasSolidSettings gs;
-  gs.biot = alpha;
-  gs.permeability_coupling = false;
-  SeepageParticipant seepage_side(seep, gs);
-  const MeshMapping map(seep.sampler());
-  SolidParticipant solid_side(solid, map, gs, seepage_side.read("pressure"), std::nullopt);
-  SchemeSettings scheme;
-  scheme.kind = SchemeSettings::Kind::one_way;
-  scheme.to_second = {"pressure"};
-  Coupling c(seepage_side, solid_side, scheme);
-  while (c.time() < 0.5) c.advance(0.005);
+  OneWay<2> one_way(seep, solid, alpha);
+  one_way.run_to(0.5, 0.005);
 
   const double f = alpha * p0 / H, M = E * (1 - nu) / ((1 + nu) * (1 - 2 * nu));
   const auto& p = solid.particles();

@@ -12,10 +12,9 @@ copy is runout/runout.csv beside this file. --measure-only runs nothing and
 measures the runs OUT holds (their rows without wall_s).
 """
 import argparse
-import concurrent.futures
 import os
 
-from ..runs import run_one, write_rows
+from ..runs import run_side_by_side, write_rows
 from .measure import run_out
 
 SCENE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "granular_collapse_3d.toml")
@@ -39,14 +38,7 @@ def main():
     walls = {}
     if not args.measure_only:
         os.makedirs(args.out, exist_ok=True)
-        with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
-            futures = {pool.submit(run_one, args.program, SCENE, o, d, 1): d for _, _, o, d in runs}
-            for done in concurrent.futures.as_completed(futures):
-                wall, note = done.result()
-                if note:
-                    raise SystemExit(f"{futures[done]}: {note}")
-                walls[futures[done]] = wall
-                print(f"  {futures[done]}: {wall:.0f} s", flush=True)
+        walls = run_side_by_side(args.program, SCENE, [(o, d) for _, _, o, d in runs], args.jobs)
     rows = []
     for fit, across, _, directory in runs:
         row = {"fit": fit, "cells_across_R0": across, **run_out(directory)}
