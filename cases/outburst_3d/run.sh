@@ -1,0 +1,22 @@
+#!/usr/bin/env bash
+# The 3D outburst (outburst_3d.toml) from one command: the run, then its
+# report and figures beside the plane case's numbers (README.md beside this
+# file). Usage:
+#   cases/outburst_3d/run.sh [--fine] [RESULTS_DIR]
+# default RESULTS_DIR results/outburst_3d (results/outburst_3d_fine with
+# --fine: the plane case's cells of 1/3 m, 233,280 particles). On all cores;
+# the plane case's run in results/outburst is compared if it is there.
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+fine=()
+default=results/outburst_3d
+if [ "${1:-}" = "--fine" ]; then
+  fine=(--set 'mpm.grid.cell_size="0.3333333333333333 m"')
+  default=results/outburst_3d_fine
+  shift
+fi
+out=${1:-$default}
+build/coupler/outburst cases/outburst_3d/outburst_3d.toml --output "$out" --overwrite "${fine[@]}"
+plane=()
+[ -f results/outburst/coupling.csv ] && plane=(--plane results/outburst)
+/usr/bin/python3 -m cases.outburst_3d.report "$out" "${plane[@]}"
