@@ -726,6 +726,18 @@ double Solver<Dim>::runaway_speed_squared(int i) const {
   return stiffness * wave_speed_squared_[particles_.material[i]];
 }
 
+// Whether every entry is finite. Eigen's allFinite() compares x - x with
+// itself, and grown with the dimension's templates it was no longer inlined
+// into the move: a call per particle, and the move 10 % slower.
+namespace {
+template <class M>
+[[gnu::always_inline]] inline bool finite(const M& m) {
+  bool all = true;
+  for (int k = 0; k < m.size(); ++k) all = all && std::isfinite(m.data()[k]);
+  return all;
+}
+}  // namespace
+
 // Books a moved particle: the work of a pore pressure on it, and whether it
 // went wrong or left.
 template <int Dim>
@@ -734,7 +746,7 @@ template <int Dim>
   // A pore pressure does work on the skeleton as it dilates.
   if (!lean_build && !p.pore_pressure.empty())
     census.external_work += p.pore_pressure[i] * p.volume[i] * p.velocity_gradient[i].trace() * dt;
-  if (!p.x[i].allFinite() || !p.v[i].allFinite() || !p.stress[i].allFinite())
+  if (!finite(p.x[i]) || !finite(p.v[i]) || !finite(p.stress[i]))
     ++census.bad;
   else if (!grid_.inside(p.x[i]))
     ++census.escaped;
@@ -890,8 +902,8 @@ void Solver<Dim>::remove_escaped(const Census& census, StepInfo& info) {
     }
   if (bad > 0)
     for (int i = 0; i < n; ++i) {
-      if (p.x[i].allFinite() && p.v[i].allFinite() && p.stress[i].allFinite()) continue;
-      const char* field = !p.x[i].allFinite() ? "position" : !p.v[i].allFinite() ? "velocity" : "stress";
+      if (finite(p.x[i]) && finite(p.v[i]) && finite(p.stress[i])) continue;
+      const char* field = !finite(p.x[i]) ? "position" : !finite(p.v[i]) ? "velocity" : "stress";
       throw SimulationError(fmt::format(
           "mpm: step {} (t = {:.6g} s): particle {} (material \"{}\") has a non-finite {}; the time "
           "step may exceed the stable one, or a material parameter is out of range",
