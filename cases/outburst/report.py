@@ -69,6 +69,13 @@ def initial_pressure(s):
     return max(value(r["initial_pressure"], "Pa") for r in s["seepage"]["regions"])
 
 
+def coal_volume(s):
+    """The coal's volume at the start: its bodies' boxes [m2 per m of depth in
+    a plane scene, m3 in 3D], shared among its particles alike."""
+    return sum(np.prod([value(b["box_max"][i], "m") - value(b["box_min"][i], "m") for i in range(len(b["box_max"]))])
+               for b in s["mpm"]["bodies"])
+
+
 class Run:
     def __init__(self, d):
         self.dir = d
@@ -315,13 +322,15 @@ def seam_bins(x0, x, face, right, top, h):
     return (ex, ey, *bin_counts(x0, x, [ex, ey]))
 
 
-def cavity_bins(full0, full1):
+def cavity_bins(full0, full1, opening=None):
     """The cavity among the seam's bins (particles per bin at t = 0 and now,
     along x first, the layer at the face first): the bins that held coal and
-    hold less than half of it now, connected to the face through each other."""
+    hold less than half of it now, connected to the face through each other,
+    opening through the face layer's bins that opening marks (default: all)."""
     emptied = (full0 > 0) & (full1 < 0.5 * full0)
     inside = np.zeros_like(emptied)
-    front = [(0, *map(int, i)) for i in np.argwhere(emptied[0])]
+    mouth = emptied[0] if opening is None else emptied[0] & opening
+    front = [(0, *map(int, i)) for i in np.argwhere(mouth)]
     while front:
         cell = front.pop()
         if inside[cell]:
