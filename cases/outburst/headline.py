@@ -2,7 +2,7 @@
 study, its ensembles and its accuracy study (measure.py) compare."""
 import numpy as np
 
-from .report import MPA, Run, axis_row, cavity, seam_bins, steepest_drop, tunnel
+from .report import MPA, Run, axis_row, cavity, seam_bins, shares, steepest_drop, tracer_peaks, tunnel
 
 # Edge of the bins the cavity is measured in [m]: one size for every
 # resolution, so that runs on other grids measure alike.
@@ -24,7 +24,7 @@ def headline(directory, time=None):
     tr = run.tracers[run.tracers["time_s"] <= t + 1e-9]
     history = run.history[run.history["time_s"] <= t + 1e-9][-1]
     coupling = run.coupling[run.coupling["time"] <= t + 1e-9][-1]
-    speed = {i: tr["speed_m_per_s"][tr["tracer"] == i].max() for i in range(3)}
+    peak = tracer_peaks(tr)
     last = run.particles(k)
     x, damage = last["points"], last["damage"].ravel()
     ejected = x[:, 0] < face
@@ -39,7 +39,7 @@ def headline(directory, time=None):
     hole = cavity(*seam_bins(run.particles(0)["points"], x, face, float(run.nodes[:, 0].max()), where["top"],
                              CAVITY_BIN)[2:], CAVITY_BIN)
     return {
-        "centre_m_per_s": speed[1], "top_m_per_s": speed[0], "bottom_m_per_s": speed[2],
+        "centre_m_per_s": peak["centre"][0], "top_m_per_s": peak["top"][0], "bottom_m_per_s": peak["bottom"][0],
         "farthest_m": face - x[:, 0].min() if ejected.any() else 0.0,
         "ejected_fraction": ejected.mean(),
         "fully_damaged_fraction": (damage >= 0.99).mean(),
@@ -48,10 +48,7 @@ def headline(directory, time=None):
         "first_drop_MPa_per_m": drops[0], "last_drop_MPa_per_m": drops[1],
         "cavity_m2_per_m": hole["area"], "cavity_depth_m": hole["depth"], "cavity_height_m": hole["height"],
         "cavity_mouth_m": hole["mouth"],
-        # What the transfer and the time step took, of the gas work.
-        "transfer_share": history["transfer_J_per_m"] / history["external_work_J_per_m"],
-        "step_share": history["integration_J_per_m"] / history["external_work_J_per_m"],
-        # What the damage took, of the gas work: the energy a fracture energy
-        # could change.
-        "damage_share": history["damage_J_per_m"] / history["external_work_J_per_m"],
+        # What the transfer and the time step took, of the gas work, and the
+        # damage: the energy a fracture energy could change.
+        **shares(history, "J_per_m"),
     }

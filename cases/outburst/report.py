@@ -10,6 +10,9 @@ section 5). Everything is read from the run's own files: particles_*.h5,
 seepage_*.h5, tracers.csv, mpm_history.csv, coupling.csv, and the geometry
 from the scene they record (the face support's box, the coal's top), unless
 the options give it.
+
+The measures and figures that do not depend on the plane are written for a 3D
+run too (cases.outburst_3d.report reads the heading with them).
 """
 import argparse
 import glob
@@ -29,6 +32,8 @@ from ..units import value
 MPA = 1e6
 # The paper's figures (section 4.2) for the table.
 PAPER = {"centre": 2.55, "top": 1.94, "bottom": 1.95, "farthest": 20.0}
+# The tracers' order in tracers.csv (the scene's list: top, middle, bottom of the face).
+TRACERS = ("top", "centre", "bottom")
 
 
 def times_of(xdmf):
@@ -45,18 +50,30 @@ def five(n):
 
 def tunnel(s):
     """The excavation face's x, the tunnel's floor and roof and the coal's top
-    [m] in an outburst scene: the face is the support removed at t = 0."""
+    [m] in an outburst scene: the face is the support removed at t = 0. In 3D
+    also the heading's half-width beside its plane of symmetry z = 0 (the
+    support's extent along z)."""
     support = [o for o in s["mpm"].get("obstacles", []) if o.get("support", False)]
     if len(support) != 1:
         raise ValueError(f"the scene has {len(support)} face supports (obstacles with support = true), not one")
-    (x0, y0), (x1, y1) = ([value(c, "m") for c in support[0][k]] for k in ("box_min", "box_max"))
+    lo, hi = ([value(c, "m") for c in support[0][k]] for k in ("box_min", "box_max"))
     top = max(value(b["box_max"][1], "m") for b in s["mpm"]["bodies"])
-    return {"face": x1, "floor": y0, "roof": y1, "top": top}
+    where = {"face": hi[0], "floor": lo[1], "roof": hi[1], "top": top}
+    if len(hi) == 3:
+        where["half_width"] = hi[2] - lo[2]
+    return where
 
 
 def initial_pressure(s):
     """The largest gas pressure at t = 0 [Pa], the pressure figure's scale."""
     return max(value(r["initial_pressure"], "Pa") for r in s["seepage"]["regions"])
+
+
+def coal_volume(s):
+    """The coal's volume at the start: its bodies' boxes [m2 per m of depth in
+    a plane scene, m3 in 3D], shared among its particles alike."""
+    return sum(np.prod([value(b["box_max"][i], "m") - value(b["box_min"][i], "m") for i in range(len(b["box_max"]))])
+               for b in s["mpm"]["bodies"])
 
 
 class Run:
@@ -66,13 +83,15 @@ class Run:
         self.seepage_files = sorted(glob.glob(os.path.join(d, "seepage_0*.h5")))
         self.times = times_of(os.path.join(d, "particles.xdmf"))
         self.seepage_times = times_of(os.path.join(d, "seepage.xdmf"))
+        self.scene = scene(d)
+        # The scene's dimension is its grid's: a plane run's mesh nodes carry a z = 0 the measures do not want.
+        self.dimension = len(self.scene["mpm"]["grid"]["size"])
         with h5py.File(os.path.join(d, "seepage_mesh.h5")) as f:
-            self.nodes = f["nodes"][:, :2]
+            self.nodes = f["nodes"][:, :self.dimension]
             self.cells = f["cells"][:]
         self.tracers = np.genfromtxt(os.path.join(d, "tracers.csv"), delimiter=",", names=True)
         self.history = np.genfromtxt(os.path.join(d, "mpm_history.csv"), delimiter=",", names=True)
         self.coupling = np.genfromtxt(os.path.join(d, "coupling.csv"), delimiter=",", names=True)
-        self.scene = scene(d)
 
     def particles(self, k):
         with h5py.File(self.particle_files[k]) as f:
@@ -96,22 +115,116 @@ def draw_rock(ax, left, face, floor, roof, top):
     ax.add_patch(plt.Rectangle((left, roof), face - left, top - roof, color="0.75", zorder=0))
 
 
-def particle_figure(run, picks, field, label, path, geometry, cmap="viridis", vmin=None, vmax=None):
+def section(geometry):
+    """What frames an x-y section of the model: its rock and its extent
+    (geometry: left, face, floor, roof, top, the model's right end)."""
+    def frame(ax):
+        draw_rock(ax, *geometry[:5])
+        ax.set_xlim(geometry[0], geometry[5])
+        ax.set_ylim(0, geometry[4])
+    return frame
+
+
+def particle_figure(run, picks, field, label, path, frame, cmap="viridis", vmin=None, vmax=None, select=None,
+                    columns=(0, 1)):
+    """A field of the particles at the picked snapshots, one panel each: all of
+    them, or those select(particles) keeps, on the plane of two coordinates;
+    frame(ax) draws the rock and sets the extent."""
     fig, axes = panel_grid(len(picks), label)
     for ax, k in zip(axes, picks):
         p = run.particles(k)
         values = field(p)
-        draw_rock(ax, *geometry[:5])
-        sc = ax.scatter(p["points"][:, 0], p["points"][:, 1], c=values, s=1.5, cmap=cmap, vmin=vmin, vmax=vmax,
-                        linewidths=0)
+        points = p["points"]
+        if select is not None:
+            keep = select(p)
+            points, values = points[keep], values[keep]
+        sc = ax.scatter(points[:, columns[0]], points[:, columns[1]], c=values, s=1.5, cmap=cmap, vmin=vmin,
+                        vmax=vmax, linewidths=0)
+        frame(ax)
         ax.set_aspect("equal")
-        ax.set_xlim(geometry[0], geometry[5])
-        ax.set_ylim(0, geometry[4])
         ax.set_title(f"t = {run.times[k]:.3g} s (snapshot {k})", fontsize=9)
         fig.colorbar(sc, ax=ax, shrink=0.9)
     axes[-1].set_xlabel("x [m]")
     fig.savefig(path, dpi=130)
     plt.close(fig)
+
+
+def pressure_figure(run, picks, quads, frame, title, path):
+    """Gas pressure on quadrilaterals of the seepage mesh's nodes (m x 4 node
+    indices: the plane mesh's cells, or the hexahedra's faces on a plane),
+    coloured by the mean of their corners."""
+    fig, axes = panel_grid(len(picks), title)
+    polys = run.nodes[:, :2][quads]
+    for ax, k in zip(axes, picks):
+        p = run.pressure(k) / MPA
+        coll = PolyCollection(polys, array=p[quads].mean(axis=1), cmap="jet", edgecolors="none")
+        coll.set_clim(0, initial_pressure(run.scene) / MPA)
+        ax.add_collection(coll)
+        frame(ax)
+        ax.set_aspect("equal")
+        ax.set_title(f"t = {run.seepage_times[k]:.3g} s", fontsize=9)
+        fig.colorbar(coll, ax=ax, shrink=0.9)
+    axes[-1].set_xlabel("x [m]")
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+
+
+def pressure_profile_figure(run, row, face, picks, path):
+    """Pressure against distance from the face on the axis's nodes (row), at
+    t = 0 and the picked snapshots; the steepest drop at every snapshot,
+    (t, drop [MPa/m], metres into the seam), which the figure returns."""
+    fig, ax = plt.subplots(figsize=(6.5, 4.2), constrained_layout=True)
+    gradients = []
+    for k in range(len(run.seepage_files)):
+        p = run.pressure(k)[row] / MPA
+        distance = run.nodes[row, 0] - face
+        gradients.append((run.seepage_times[k], *steepest_drop(p, distance)))
+        if k in picks or k == 0:
+            ax.plot(distance, p, marker=".", label=f"t = {run.seepage_times[k]:.3g} s")
+    ax.set_xlabel("distance from the excavation face [m]")
+    ax.set_ylabel("gas pressure p [MPa]")
+    where = f"y = {run.nodes[row[0], 1]:.3g} m" + (", z = 0" if run.dimension == 3 else "")
+    ax.set_title(f"Gas pressure along the tunnel axis ({where}) (Fig. 4)")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+    return gradients
+
+
+def displacement(tr):
+    """How far the tracer rows' particles have moved [m]."""
+    moved = np.hypot(tr["ux_m"], tr["uy_m"])
+    return np.hypot(moved, tr["uz_m"]) if "uz_m" in tr.dtype.names else moved
+
+
+def tracer_peaks(tr):
+    """Each tracer's (peak speed [m/s], its time [s], its last displacement [m]), by TRACERS' names."""
+    peak = {}
+    for k, name in enumerate(TRACERS):
+        sel = tr[tr["tracer"] == k]
+        i = np.argmax(sel["speed_m_per_s"])
+        peak[name] = (sel["speed_m_per_s"][i], sel["time_s"][i], displacement(sel)[-1])
+    return peak
+
+
+def tracer_figures(tr, out):
+    """Figs. 8-9: the tracers' speed and displacement against time."""
+    names = {0: "particle 1 (top)", 1: "particle 2 (middle)", 2: "particle 3 (bottom)"}
+    for column, label, path, title in (
+            ("speed_m_per_s", "speed [m/s]", "fig8_tracer_velocity.png", "Tracer speed (Fig. 8)"),
+            (None, "displacement [m]", "fig9_tracer_displacement.png", "Tracer displacement (Fig. 9)")):
+        fig, ax = plt.subplots(figsize=(6.5, 4.2), constrained_layout=True)
+        for k in range(3):
+            sel = tr[tr["tracer"] == k]
+            ax.plot(sel["time_s"], sel[column] if column else displacement(sel), label=names[k])
+        ax.set_xlabel("time [s]")
+        ax.set_ylabel(label)
+        ax.set_title(title)
+        ax.grid(alpha=0.3)
+        ax.legend()
+        fig.savefig(out(path), dpi=130)
+        plt.close(fig)
 
 
 def main():
@@ -133,76 +246,25 @@ def main():
     face, floor, roof, top = args.face, args.tunnel_floor, args.tunnel_roof, args.top
     # The tunnel runs from the model's left edge to the face.
     left, width = float(run.nodes[:, 0].min()), float(run.nodes[:, 0].max())
-    geometry = (left, face, floor, roof, top, width)
+    frame = section((left, face, floor, roof, top, width))
     out = lambda name: os.path.join(args.results, name)
     picks = five(len(run.particle_files))
     seep_picks = five(len(run.seepage_files))
 
-    # Fig. 3: gas pressure on the seepage mesh.
-    fig, axes = panel_grid(len(seep_picks), "Gas pressure p [MPa] (Fig. 3)")
-    polys = run.nodes[run.cells]
-    for ax, k in zip(axes, seep_picks):
-        p = run.pressure(k) / MPA
-        coll = PolyCollection(polys, array=p[run.cells].mean(axis=1), cmap="jet", edgecolors="none")
-        coll.set_clim(0, initial_pressure(run.scene) / MPA)
-        ax.add_collection(coll)
-        draw_rock(ax, *geometry[:5])
-        ax.set_xlim(left, width)
-        ax.set_ylim(0, top)
-        ax.set_aspect("equal")
-        ax.set_title(f"t = {run.seepage_times[k]:.3g} s", fontsize=9)
-        fig.colorbar(coll, ax=ax, shrink=0.9)
-    axes[-1].set_xlabel("x [m]")
-    fig.savefig(out("fig3_pressure.png"), dpi=130)
-    plt.close(fig)
-
-    # Fig. 4: pressure against distance from the face, along the tunnel's axis.
-    mid = 0.5 * (floor + roof)
-    row = axis_row(run.nodes, face, mid)
-    fig, ax = plt.subplots(figsize=(6.5, 4.2), constrained_layout=True)
-    gradients = []
-    for k in range(len(run.seepage_files)):
-        p = run.pressure(k)[row] / MPA
-        distance = run.nodes[row, 0] - face
-        gradients.append((run.seepage_times[k], *steepest_drop(p, distance)))
-        if k in seep_picks or k == 0:
-            ax.plot(distance, p, marker=".", label=f"t = {run.seepage_times[k]:.3g} s")
-    ax.set_xlabel("distance from the excavation face [m]")
-    ax.set_ylabel("gas pressure p [MPa]")
-    ax.set_title(f"Gas pressure along the tunnel axis (y = {run.nodes[row[0], 1]:.3g} m) (Fig. 4)")
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
-    fig.savefig(out("fig4_pressure_profile.png"), dpi=130)
-    plt.close(fig)
+    pressure_figure(run, seep_picks, run.cells, frame, "Gas pressure p [MPa] (Fig. 3)", out("fig3_pressure.png"))
+    gradients = pressure_profile_figure(run, axis_row(run.nodes, face, 0.5 * (floor + roof)), face, seep_picks,
+                                        out("fig4_pressure_profile.png"))
 
     # Figs. 5-7: damage, minimum principal stress, speed.
     particle_figure(run, picks, lambda p: p["damage"].ravel(), "Damage D (Fig. 5)", out("fig5_damage.png"),
-                    geometry, cmap="inferno_r", vmin=0, vmax=1)
+                    frame, cmap="inferno_r", vmin=0, vmax=1)
     particle_figure(run, picks, lambda p: p["sigma_min"].ravel() / MPA,
                     "Minimum principal effective stress [MPa], tension positive (Fig. 6)",
-                    out("fig6_min_principal_stress.png"), geometry, cmap="coolwarm")
+                    out("fig6_min_principal_stress.png"), frame, cmap="coolwarm")
     particle_figure(run, picks, lambda p: np.linalg.norm(p["velocity"], axis=1), "Particle speed [m/s] (Fig. 7)",
-                    out("fig7_velocity.png"), geometry, cmap="turbo")
+                    out("fig7_velocity.png"), frame, cmap="turbo")
 
-    # Figs. 8-9: tracers at the top, middle and bottom of the face.
-    names = {0: "particle 1 (top)", 1: "particle 2 (middle)", 2: "particle 3 (bottom)"}
-    tr = run.tracers
-    for column, label, path, title in (
-            ("speed_m_per_s", "speed [m/s]", "fig8_tracer_velocity.png", "Tracer speed (Fig. 8)"),
-            (None, "displacement [m]", "fig9_tracer_displacement.png", "Tracer displacement (Fig. 9)")):
-        fig, ax = plt.subplots(figsize=(6.5, 4.2), constrained_layout=True)
-        for k in range(3):
-            sel = tr["tracer"] == k
-            values = tr[column][sel] if column else np.hypot(tr["ux_m"][sel], tr["uy_m"][sel])
-            ax.plot(tr["time_s"][sel], values, label=names[k])
-        ax.set_xlabel("time [s]")
-        ax.set_ylabel(label)
-        ax.set_title(title)
-        ax.grid(alpha=0.3)
-        ax.legend()
-        fig.savefig(out(path), dpi=130)
-        plt.close(fig)
-
+    tracer_figures(run.tracers, out)
     write_report(run, args, gradients, out("report.md"))
 
 
@@ -227,10 +289,13 @@ def pile_and_seam_figure(heights, ex, ey, fill, time, tunnel_height, path):
 
 def axis_row(nodes, face, mid):
     """The seepage nodes on the tunnel's axis (the row of nodes nearest y = mid:
-    a mesh with an odd number of elements over the tunnel has none on it) from
-    the face inward, in order."""
+    a mesh with an odd number of elements over the tunnel has none on it; in
+    3D on the plane of symmetry z = 0) from the face inward, in order."""
     nearest = nodes[np.argmin(np.abs(nodes[:, 1] - mid)), 1]
-    row = np.where((np.abs(nodes[:, 1] - nearest) < 1e-6) & (nodes[:, 0] >= face - 1e-9))[0]
+    on_axis = (np.abs(nodes[:, 1] - nearest) < 1e-6) & (nodes[:, 0] >= face - 1e-9)
+    if nodes.shape[1] == 3:
+        on_axis &= np.abs(nodes[:, 2]) < 1e-6
+    row = np.where(on_axis)[0]
     return row[np.argsort(nodes[row, 0])]
 
 
@@ -243,55 +308,127 @@ def steepest_drop(p, distance):
     return slope[k], distance[k]
 
 
+def bin_counts(x0, x, edges):
+    """The particles in each bin of the edges (one array per coordinate, the
+    first coordinates' in order) at t = 0 (x0) and now (x)."""
+    d = len(edges)
+    return np.histogramdd(x0[:, :d], bins=edges)[0], np.histogramdd(x[:, :d], bins=edges)[0]
+
+
 def seam_bins(x0, x, face, right, top, h):
     """Square bins of edge h over the seam (face..right, 0..top): their edges and
     the particles in each at t = 0 (x0) and now (x)."""
     ex, ey = np.arange(face, right + 1e-9, h), np.arange(0.0, top + 1e-9, h)
-    return (ex, ey, np.histogram2d(x0[:, 0], x0[:, 1], bins=[ex, ey])[0],
-            np.histogram2d(x[:, 0], x[:, 1], bins=[ex, ey])[0])
+    return (ex, ey, *bin_counts(x0, x, [ex, ey]))
+
+
+def cavity_bins(full0, full1, opening=None):
+    """The cavity among the seam's bins (particles per bin at t = 0 and now,
+    along x first, the layer at the face first): the bins that held coal and
+    hold less than half of it now, connected to the face through each other,
+    opening through the face layer's bins that opening marks (default: all)."""
+    emptied = (full0 > 0) & (full1 < 0.5 * full0)
+    inside = np.zeros_like(emptied)
+    mouth = emptied[0] if opening is None else emptied[0] & opening
+    front = [(0, *map(int, i)) for i in np.argwhere(mouth)]
+    while front:
+        cell = front.pop()
+        if inside[cell]:
+            continue
+        inside[cell] = True
+        for axis in range(emptied.ndim):
+            for step in (1, -1):
+                n = cell[:axis] + (cell[axis] + step,) + cell[axis + 1:]
+                if 0 <= n[axis] < emptied.shape[axis] and emptied[n] and not inside[n]:
+                    front.append(n)
+    return inside
+
+
+def depth_of(bins, h):
+    """How far from the face the marked bins of edge h reach [m]."""
+    return (np.nonzero(bins.any(axis=tuple(range(1, bins.ndim))))[0].max() + 1) * h
 
 
 def cavity(full0, full1, h):
-    """The cavity in the seam's bins of edge h (particles per bin at t = 0 and
-    now, the first row of bins at the face): the bins that held coal and hold
-    less than half of it now, connected to the face. Its area, depth from the
-    face, largest height and mouth on the face, in metres."""
-    emptied = (full0 > 0) & (full1 < 0.5 * full0)
-    inside = np.zeros_like(emptied)
-    front = [(0, j) for j in range(emptied.shape[1]) if emptied[0, j]]
-    while front:
-        i, j = front.pop()
-        if inside[i, j]:
-            continue
-        inside[i, j] = True
-        for a, b in ((i + 1, j), (i - 1, j), (i, j + 1), (i, j - 1)):
-            if 0 <= a < emptied.shape[0] and 0 <= b < emptied.shape[1] and emptied[a, b] and not inside[a, b]:
-                front.append((a, b))
+    """The cavity in the seam's bins of edge h (cavity_bins): its area, depth
+    from the face, largest height and mouth on the face, in metres."""
+    inside = cavity_bins(full0, full1)
     if not inside.any():
         return {"area": 0.0, "depth": 0.0, "height": 0.0, "mouth": 0.0}
-    return {"area": inside.sum() * h * h, "depth": (np.nonzero(inside.any(axis=1))[0].max() + 1) * h,
+    return {"area": inside.sum() * h * h, "depth": depth_of(inside, h),
             "height": inside.sum(axis=1).max() * h, "mouth": inside[0].sum() * h}
 
 
+def loose_bins(held0, held1):
+    """The loosened seam coal: bins that hold less than 95 % of their coal at
+    t = 0 (the void the ejected coal left, spread out)."""
+    return (held0 > 0) & (held1 < 0.95 * held0)
+
+
 def loosened(held0, held1, h):
-    """The loosened seam coal: bins of edge h that hold less than 95 % of their
-    coal at t = 0 (the void the ejected coal left, spread out). Their area,
+    """The loosened seam coal (loose_bins) in bins of edge h: their area,
     depth from the face and the share of the coal they still hold."""
-    loose = (held0 > 0) & (held1 < 0.95 * held0)
+    loose = loose_bins(held0, held1)
     if not loose.any():
         return {"area": 0.0, "depth": 0.0, "fill": 1.0}
-    return {"area": loose.sum() * h * h, "depth": (np.nonzero(loose.any(axis=1))[0].max() + 1) * h,
+    return {"area": loose.sum() * h * h, "depth": depth_of(loose, h),
             "fill": held1[loose].sum() / held0[loose].sum()}
+
+
+def ejection_start(run, face):
+    """Where ejection starts: the first snapshot with coal in front of the face,
+    its time [s] and the median height of that coal [m]; (None, None) if none."""
+    for k in range(1, len(run.particle_files)):
+        p = run.particles(k)["points"]
+        out = p[:, 0] < face - 0.1
+        if out.any():
+            return run.times[k], float(np.median(p[out, 1]))
+    return None, None
+
+
+def pile_heights(x, ejected, face, floor, farthest):
+    """The height of the coal above the tunnel floor [m] in 1 m bins from the
+    face out to the farthest coal."""
+    heights = []
+    for d in np.arange(0.0, farthest, 1.0):
+        sel = ejected & (x[:, 0] < face - d) & (x[:, 0] >= face - d - 1)
+        heights.append(x[sel, 1].max() - floor if sel.any() else 0.0)
+    return heights
+
+
+def shares(e, unit):
+    """What the grid transfer, the time step and the damage took of the gas
+    work, from a row of mpm_history.csv whose energies are in unit ("J_per_m"
+    in a plane run, "J" in 3D)."""
+    work = e[f"external_work_{unit}"]
+    return {"transfer_share": e[f"transfer_{unit}"] / work, "step_share": e[f"integration_{unit}"] / work,
+            "damage_share": e[f"damage_{unit}"] / work}
+
+
+def energy_table(e, unit, walls):
+    """The energy books at a row of mpm_history.csv as a Markdown table;
+    walls names what the walls' friction acts on."""
+    terms = ["kinetic", "strain", "plastic", "damage", "walls", "transfer", "integration", "left_grid"]
+    return [
+        f"| gas work | kinetic | strain | plastic | damage | {walls} | grid transfer "
+        "| time step | left the grid | balance error |",
+        "|---|---|---|---|---|---|---|---|---|---|",
+        f"| {e[f'external_work_{unit}']:.4g} | " + " | ".join(f"{e[f'{t}_{unit}']:.4g}" for t in terms) + " | "
+        f"{e[f'balance_error_{unit}']:.4g} ({e[f'balance_error_{unit}'] / e[f'external_work_{unit}']:+.2%} of "
+        "the gas work) |",
+    ]
+
+
+ENERGY_NOTE = ("The grid transfer is what the grid-to-particle transfer takes from the grid's update: the PIC share "
+               "of the FLIP/PIC blend (or APIC) takes the velocity differences of coal within a cell, separating "
+               "fragments above all, and the update's spread over each particle's nodes is lost in its "
+               "interpolation. The time step is the explicit step's own energy error (negative: energy it gave); "
+               "both fall with the step. The balance error is what neither holds (mpm_solid/README.md, Energies).")
 
 
 def write_report(run, args, gradients, path):
     face, floor, roof = args.face, args.tunnel_floor, args.tunnel_roof
-    tr = run.tracers
-    peak = {}
-    for k, name in enumerate(("top", "centre", "bottom")):
-        sel = tr["tracer"] == k
-        i = np.argmax(tr["speed_m_per_s"][sel])
-        peak[name] = (tr["speed_m_per_s"][sel][i], tr["time_s"][sel][i], np.hypot(tr["ux_m"][sel], tr["uy_m"][sel])[-1])
+    peak = tracer_peaks(run.tracers)
     last = run.particles(len(run.particle_files) - 1)
     first = run.particles(0)
     x0 = first["points"]
@@ -299,21 +436,8 @@ def write_report(run, args, gradients, path):
     ejected = x[:, 0] < face
     farthest = face - x[:, 0].min() if ejected.any() else 0.0
     removed = int(run.history["removed_total"][-1])
-    # Where ejection starts: the first snapshot with coal in front of the face.
-    start_time, start_height = None, None
-    for k in range(1, len(run.particle_files)):
-        p = run.particles(k)["points"]
-        out = p[:, 0] < face - 0.1
-        if out.any():
-            start_time = run.times[k]
-            start_height = float(np.median(p[out, 1]))
-            break
-    # Pile: height of the coal above the tunnel floor in 1 m bins from the face
-    # out to the farthest coal.
-    heights = []
-    for d in np.arange(0.0, farthest, 1.0):
-        sel = ejected & (x[:, 0] < face - d) & (x[:, 0] >= face - d - 1)
-        heights.append(x[sel, 1].max() - floor if sel.any() else 0.0)
+    start_time, start_height = ejection_start(run, face)
+    heights = pile_heights(x, ejected, face, floor, farthest)
     right = float(run.nodes[:, 0].max())
     cav = cavity(*seam_bins(x0, x, face, right, args.top, 0.5)[2:], 0.5)
     ex1, ey1, held0, held1 = seam_bins(x0, x, face, right, args.top, 1.0)
@@ -377,20 +501,9 @@ def write_report(run, args, gradients, path):
         "",
         "## Energy budget (J per m of depth, at the end)",
         "",
-        "| gas work | kinetic | strain | plastic | damage | roof, floor (friction) | grid transfer "
-        "| time step | left the grid | balance error |",
-        "|---|---|---|---|---|---|---|---|---|---|",
-        f"| {e['external_work_J_per_m']:.4g} | {e['kinetic_J_per_m']:.4g} | {e['strain_J_per_m']:.4g} | "
-        f"{e['plastic_J_per_m']:.4g} | {e['damage_J_per_m']:.4g} | {e['walls_J_per_m']:.4g} | "
-        f"{e['transfer_J_per_m']:.4g} | {e['integration_J_per_m']:.4g} | {e['left_grid_J_per_m']:.4g} | "
-        f"{e['balance_error_J_per_m']:.4g} ({e['balance_error_J_per_m'] / e['external_work_J_per_m']:+.2%} of "
-        "the gas work) |",
+        *energy_table(e, "J_per_m", "roof, floor (friction)"),
         "",
-        "The grid transfer is what the grid-to-particle transfer takes from the grid's update: the PIC share "
-        "of the FLIP/PIC blend (or APIC) takes the velocity differences of coal within a cell, separating "
-        "fragments above all, and the update's spread over each particle's nodes is lost in its "
-        "interpolation. The time step is the explicit step's own energy error (negative: energy it gave); "
-        "both fall with the step. The balance error is what neither holds (mpm_solid/README.md, Energies).",
+        ENERGY_NOTE,
         "",
         "Figures: fig3_pressure.png, fig4_pressure_profile.png, fig5_damage.png, "
         "fig6_min_principal_stress.png, fig7_velocity.png, fig8_tracer_velocity.png, "
