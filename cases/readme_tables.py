@@ -438,6 +438,12 @@ def mpm_benchmark_builds(rows):
     return lines
 
 
+@block("mpm benchmark plane against 847e87c", "mpm_solid/benchmark/compare-847e87c-9ab1216.csv")
+def mpm_benchmark_dimension(rows):
+    """The plane kernels written once for both dimensions against the last plane-only build."""
+    return mpm_benchmark_builds(rows)
+
+
 @block("outburst cost", "cases/outburst/benchmark/outburst-benchmark.csv")
 def outburst_cost(rows):
     """scripts/outburst-benchmark.py's CSV: wall time and the solid's throughput, build against build."""
@@ -465,6 +471,24 @@ def mpm_benchmark(rows):
         memory = [f"{int(float(by_material[m]['bytes_per_particle']))} + "
                   f"{int(float(by_material[m]['grid_bytes_per_particle']))}" for m in materials]
         lines.append(f"| {sci(n, 0)} | {shape} | " + " | ".join(speeds) + " | " + ", ".join(memory) + " |")
+    return lines
+
+
+@block("mpm benchmark 3d", "mpm_solid/benchmark/mpm-benchmark-3d.csv", "mpm_solid/benchmark/mpm-benchmark.csv")
+def mpm_benchmark_3d(rows, plane):
+    """The 3D rows, and what a 3D particle-step costs against a plane one (one thread)."""
+    lines = mpm_benchmark(rows)
+    flat = {(r["particles"], r["shape"], r["material"]): float(r["one_thread"]) for r in plane}
+    ratios = {}
+    for r in rows:
+        key = (r["particles"], r["shape"], r["material"])
+        if key in flat:
+            ratios.setdefault((int(r["particles"]), r["shape"]), []).append(
+                (r["material"], flat[key] / float(r["one_thread"])))
+    lines += ["", "| particles | shape | 3D particle-step over a plane one: " +
+              " / ".join(m for m, _ in next(iter(ratios.values()))) + " |", "|---|---|---|"]
+    for (n, shape), by in ratios.items():
+        lines.append(f"| {sci(n, 0)} | {shape} | " + " / ".join(f"{ratio:.2f}" for _, ratio in by) + " |")
     return lines
 
 
