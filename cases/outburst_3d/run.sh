@@ -5,7 +5,8 @@
 #   cases/outburst_3d/run.sh [--fine] [RESULTS_DIR]
 # default RESULTS_DIR results/outburst_3d (results/outburst_3d_fine with
 # --fine: the plane case's cells of 1/3 m, 233,280 particles). On all cores;
-# the plane case's run in results/outburst is compared if it is there.
+# the plane case's run in results/outburst is compared if it is there. The
+# run's log is written beside its folder (RESULTS_DIR.log).
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 fine=()
@@ -16,7 +17,10 @@ if [ "${1:-}" = "--fine" ]; then
   shift
 fi
 out=${1:-$default}
-build/coupler/outburst cases/outburst_3d/outburst_3d.toml --output "$out" --overwrite "${fine[@]}"
+# The log beside the folder (the report reads the run's wall time from it).
+mkdir -p "$(dirname "$out")"
+build/coupler/outburst cases/outburst_3d/outburst_3d.toml --output "$out" --overwrite "${fine[@]}" 2>&1 |
+  tee "$out.log"
 plane=()
 [ -f results/outburst/coupling.csv ] && plane=(--plane results/outburst)
-/usr/bin/python3 -m cases.outburst_3d.report "$out" "${plane[@]}"
+/usr/bin/python3 -m cases.outburst_3d.report "$out" --log "$out.log" "${plane[@]}"
