@@ -3,6 +3,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <numeric>
 #include <cmath>
 #include <type_traits>
 
@@ -240,10 +241,14 @@ Solver<Dim>::Solver(Grid<Dim> grid, std::vector<std::unique_ptr<Material<Dim>>> 
   for (const Platen<Dim>& platen : settings_.platens) {
     if (!(platen.upper.array() > platen.lower.array()).all())
       throw std::invalid_argument("a platen's upper corner must lie above and right of its lower corner");
+    // Not the ghosts beyond a fixed or roller wall: their mass is folded into
+    // the nodes inside (counted twice in the plate's momentum otherwise), and
+    // the walls set their motion by mirroring.
     auto& nodes = platen_nodes_.emplace_back();
     for (std::size_t i = 0; i < node_ij_.size(); ++i) {
       const Vec<Dim> x = grid_.node_position(node_ij_[i]);
-      if ((x.array() >= platen.lower.array()).all() && (x.array() <= platen.upper.array()).all()) nodes.push_back(i);
+      if (counted_[i] && (x.array() >= platen.lower.array()).all() && (x.array() <= platen.upper.array()).all())
+        nodes.push_back(i);
     }
     if (nodes.empty()) throw std::invalid_argument("a platen's box holds no grid node");
   }
@@ -682,10 +687,18 @@ template <int Dim>
 double Solver<Dim>::apply_walls(std::vector<Vec<Dim>>& velocity) const {
   const int g = Grid<Dim>::ghost;
   double friction_work = 0;
+  // On the wall rows friction acts last: where a friction wall meets another
+  // in 3D, the other's normal velocity is not slip along the friction wall
+  // (in the plane the order makes no difference there).
+  std::array<int, 2 * Dim> in_turn, friction_last;
+  std::iota(in_turn.begin(), in_turn.end(), 0);
+  friction_last = in_turn;
+  std::stable_partition(friction_last.begin(), friction_last.end(),
+                        [&](int side) { return settings_.walls[side].type != Wall::Type::friction; });
   // Wall rows first, then ghost rows outward, so that every mirror is final
   // when it is read (thin domains mirror one wall's ghosts in the other's).
   for (int depth = 0; depth <= g; ++depth) {
-    for (int side = 0; side < 2 * Dim; ++side) {
+    for (const int side : depth == 0 ? friction_last : in_turn) {
       const Wall& wall = settings_.walls[side];
       if (wall.type == Wall::Type::open) continue;
       const int axis = side / 2;
@@ -703,16 +716,20 @@ double Solver<Dim>::apply_walls(std::vector<Vec<Dim>>& velocity) const {
           for (int d = 0; d < Dim; ++d) v[d] = d == axis || wall.type == Wall::Type::fixed ? -m[d] : m[d];
           return;
         }
-        friction_work += constrain(v, normal, wall, mass_[i]);
+        // A ghost beyond a fixed or roller wall takes its mirror's motion
+        // next, and its mass is folded into that node's: its work is not its own.
+        const double work = constrain(v, normal, wall, mass_[i]);
+        if (counted_[i]) friction_work += work;
       });
     }
     if (depth > 0) continue;
     // Most of an obstacle's nodes lie deep in the rock, where no particle
     // reaches: at rest, which every contact leaves at rest.
     for (const auto& o : obstacle_nodes_)
-      if (const Vec<Dim>& v = velocity[o.node]; (v.array() != 0).any())
-        friction_work +=
-            constrain(velocity[o.node], o.normal, settings_.obstacles[o.obstacle].contact, mass_[o.node]);
+      if (const Vec<Dim>& v = velocity[o.node]; (v.array() != 0).any()) {
+        const double work = constrain(velocity[o.node], o.normal, settings_.obstacles[o.obstacle].contact, mass_[o.node]);
+        if (counted_[o.node]) friction_work += work;
+      }
   }
   return friction_work;
 }

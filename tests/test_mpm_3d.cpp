@@ -3,14 +3,16 @@
 //    order under each shape function;
 //  - a slab between roller walls is plane strain: it moves as the 2D solver's
 //    body does, particle for particle, for elastic, plastic and damaging
-//    material;
+//    material, and under every load, contact and velocity transfer;
 //  - a column under gravity settles to the stress its weight gives;
 //  - the grid's passes stay within the blocks the particles reach.
 #include <catch2/catch.hpp>
 #include <omp.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
+#include <ostream>
 #include <utility>
 
 #include "convergence.hpp"
@@ -145,6 +147,41 @@ Settings<Dim> landing(ShapeKind shape, Scheme scheme) {
   return s;
 }
 
+
+// How far a slab's particles are from the plane body's, each plane particle
+// standing for a column of 3D ones across the slab (4 of them), and what
+// plane strain has none of: motion along z, shear across the slab.
+struct SlabDifference {
+  double position = 0, velocity = 0, stress = 0, out_of_plane = 0, damage = 0, across = 0;
+  double scale = 0;  // the largest plane stress [Pa]
+};
+
+SlabDifference slab_against_plane(const Particles<2>& a, const Particles<3>& b, bool damage) {
+  REQUIRE(b.size() == 4 * a.size());
+  std::map<std::pair<long, long>, std::size_t> by_start;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    by_start[{std::lround(a.x0[i].x() * 1e6), std::lround(a.x0[i].y() * 1e6)}] = i;
+  SlabDifference d;
+  for (std::size_t j = 0; j < b.size(); ++j) {
+    const std::size_t i = by_start.at({std::lround(b.x0[j].x() * 1e6), std::lround(b.x0[j].y() * 1e6)});
+    d.position = std::max(d.position, (b.x[j].head<2>() - a.x[i]).norm());
+    d.velocity = std::max(d.velocity, (b.v[j].head<2>() - a.v[i]).norm());
+    d.stress = std::max(d.stress, (b.stress[j].topLeftCorner<2, 2>() - a.stress[i]).cwiseAbs().maxCoeff());
+    d.out_of_plane = std::max(d.out_of_plane, std::abs(b.stress[j](2, 2) - a.stress_zz[i]));
+    if (damage) d.damage = std::max(d.damage, std::abs(b.damage[j] - a.damage[i]));
+    d.across = std::max({d.across, std::abs(b.x[j].z() - b.x0[j].z()),
+                         b.stress[j].col(2).head<2>().cwiseAbs().maxCoeff() /
+                             std::max(1.0, a.stress[i].cwiseAbs().maxCoeff())});
+    d.scale = std::max(d.scale, a.stress[i].cwiseAbs().maxCoeff());
+  }
+  return d;
+}
+
+std::ostream& operator<<(std::ostream& out, const SlabDifference& d) {
+  return out << "3D against plane: position " << d.position << " m, velocity " << d.velocity << " m/s, stress "
+             << d.stress << " Pa, out-of-plane stress " << d.out_of_plane << " Pa, damage " << d.damage
+             << "; across the slab " << d.across << "; largest stress " << d.scale << " Pa";
+}
 }  // namespace
 
 // Plane strain is the 3D state with no motion along z: a slab between roller
@@ -173,41 +210,113 @@ TEST_CASE("3D: a slab between roller walls moves as the plane-strain body does, 
     plane.step(dt);
     solid.step(dt);
   }
-  // Each plane particle stands for a column of 3D ones (4 across the slab).
   const auto& a = plane.particles();
-  const auto& b = solid.particles();
-  REQUIRE(b.size() == 4 * a.size());
-  std::map<std::pair<long, long>, std::size_t> by_start;
-  for (std::size_t i = 0; i < a.size(); ++i)
-    by_start[{std::lround(a.x0[i].x() * 1e6), std::lround(a.x0[i].y() * 1e6)}] = i;
-  double position = 0, velocity = 0, stress = 0, out_of_plane = 0, damage = 0, across = 0, scale = 0;
-  for (std::size_t j = 0; j < b.size(); ++j) {
-    const std::size_t i = by_start.at({std::lround(b.x0[j].x() * 1e6), std::lround(b.x0[j].y() * 1e6)});
-    position = std::max(position, (b.x[j].head<2>() - a.x[i]).norm());
-    velocity = std::max(velocity, (b.v[j].head<2>() - a.v[i]).norm());
-    stress = std::max(stress, (b.stress[j].topLeftCorner<2, 2>() - a.stress[i]).cwiseAbs().maxCoeff());
-    out_of_plane = std::max(out_of_plane, std::abs(b.stress[j](2, 2) - a.stress_zz[i]));
-    if (m == Model::damage) damage = std::max(damage, std::abs(b.damage[j] - a.damage[i]));
-    // What plane strain has none of: motion along z, shear across the slab.
-    across = std::max({across, std::abs(b.x[j].z() - b.x0[j].z()), b.stress[j].col(2).head<2>().cwiseAbs().maxCoeff() /
-                                                                       std::max(1.0, a.stress[i].cwiseAbs().maxCoeff())});
-    scale = std::max(scale, a.stress[i].cwiseAbs().maxCoeff());
-  }
-  INFO("3D against plane: position " << position << " m, velocity " << velocity << " m/s, stress " << stress
-                                     << " Pa, out-of-plane stress " << out_of_plane << " Pa, damage " << damage
-                                     << "; across the slab " << across << "; largest stress " << scale << " Pa");
-  CHECK(position < 1e-8 * 1.0);
-  CHECK(velocity < 1e-8 * speed);
-  CHECK(stress < 1e-8 * scale);
-  CHECK(out_of_plane < 1e-8 * scale);
-  CHECK(damage < 1e-8);
-  CHECK(across < 1e-8);
+  const SlabDifference d = slab_against_plane(a, solid.particles(), m == Model::damage);
+  INFO(d);
+  CHECK(d.position < 1e-8 * 1.0);
+  CHECK(d.velocity < 1e-8 * speed);
+  CHECK(d.stress < 1e-8 * d.scale);
+  CHECK(d.out_of_plane < 1e-8 * d.scale);
+  CHECK(d.damage < 1e-8);
+  CHECK(d.across < 1e-8);
   if (m == Model::drucker_prager) CHECK(*std::max_element(a.plastic_strain.begin(), a.plastic_strain.end()) > 0);
   if (m == Model::damage) CHECK(*std::max_element(a.damage.begin(), a.damage.end()) == 1.0);
   // The slab is two cells, 0.2 m, deep: the plane energies are per metre.
   const Energies e2 = plane.energies(), e3 = solid.energies();
   CHECK(e3.kinetic == Approx(0.2 * e2.kinetic).epsilon(1e-8));
   CHECK(e3.strain + e3.plastic + e3.damage == Approx(0.2 * (e2.strain + e2.plastic + e2.damage)).epsilon(1e-8));
+  CHECK(e3.total() == Approx(0.2 * e2.total()).epsilon(1e-8).margin(1e-9 * 0.2 * e2.kinetic));
+}
+
+namespace {
+
+// The slab of a loaded body, plane or 3D: Drucker-Prager coal holding an
+// in-situ stress slides left across a friction obstacle (the floor rock)
+// into a friction wall, pressed from above by a platen and from the right by
+// a traction, under gravity. The 3D loads are the plane ones (per metre)
+// times the slab's depth, shared among its particles as a scene's are.
+template <int Dim>
+Solver<Dim> loaded_slab(ShapeKind shape, bool apic) {
+  const double h = 0.1, depth = 2 * h, spacing = h / 2, rock = 0.1, top = 0.7, right = 0.85;
+  const Vec<2> size(2.0, 1.5);
+  Grid<Dim> g;
+  if constexpr (Dim == 2) g = grid(size.x(), size.y(), h);
+  else g = grid(Vec<3>(size.x(), size.y(), depth), h);
+  // Boxes of the plane, across the whole slab in 3D.
+  auto box = [](double x, double y, double z) {
+    Vec<Dim> v;
+    v.template head<2>() = Vec<2>(x, y);
+    if constexpr (Dim == 3) v.z() = z;
+    return v;
+  };
+  Particles<Dim> p = block<Dim>(g, box(0.05, rock, 0), box(right, top, depth), 1000, 2);
+  const double nu = 0.3, sxx = -2e4, syy = -1e4;
+  p.need_loads();
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    p.v[i] = box(-2.0, 0, 0);
+    p.stress[i].setZero();
+    p.stress[i](0, 0) = sxx;
+    p.stress[i](1, 1) = syy;
+    if constexpr (Dim == 2) p.stress_zz[i] = nu * (sxx + syy);
+    else p.stress[i](2, 2) = nu * (sxx + syy);
+    // 5 kPa pushing into the right face, on its outermost layer of particles.
+    if (p.x[i].x() > right - spacing) p.surface_force[i].x() = -5e3 * (Dim == 2 ? spacing : spacing * spacing);
+  }
+  Settings<Dim> s;
+  s.empty_node_mass_fraction = 0;  // as landing's
+  s.shape = shape;
+  s.scheme = Scheme::usl;
+  s.apic = apic;
+  s.flip_fraction = 0.5;
+  s.gravity = box(0, -9.81, 0);
+  s.walls[0] = Wall{Wall::Type::friction, 0.3};
+  if constexpr (Dim == 3) s.walls[4] = s.walls[5] = Wall{Wall::Type::roller};
+  s.obstacles.push_back({box(-1, -1, -1), box(3, rock, 1), Wall{Wall::Type::friction, 0.4}});
+  s.platens.push_back({box(-1, top, -1), box(3, 2, 1), 1, -2e3 * (Dim == 2 ? 1.0 : depth), std::nullopt});
+  return Solver<Dim>(g, model<Dim>(Model::drucker_prager), std::move(p), s);
+}
+
+}  // namespace
+
+// Every load and contact a scene can name, and the velocity transfers, on
+// the slab: it moves as the plane body does, particle for particle.
+TEST_CASE("3D: a slab under in-situ stress, a platen, a traction, friction walls and obstacles moves as the "
+          "plane body does, under APIC and a FLIP/PIC blend",
+          "[mpm][3d]") {
+  const bool apic = GENERATE(false, true);
+  const ShapeKind shape = GENERATE(ShapeKind::linear, ShapeKind::gimp, ShapeKind::bspline);
+  const ThreadsFor one(1);
+  Solver<2> plane = loaded_slab<2>(shape, apic);
+  Solver<3> solid = loaded_slab<3>(shape, apic);
+  const double dt = plane.stable_time_step();
+  for (int k = 0; k < 200; ++k) {
+    plane.step(dt);
+    solid.step(dt);
+  }
+  const auto& a = plane.particles();
+  const SlabDifference d = slab_against_plane(a, solid.particles(), false);
+  INFO(d);
+  CHECK(d.position < 1e-8 * 1.0);
+  CHECK(d.velocity < 1e-8 * 2.0);
+  CHECK(d.stress < 1e-8 * d.scale);
+  CHECK(d.out_of_plane < 1e-8 * d.scale);
+  CHECK(d.across < 1e-8);
+  // Each load acted: the wall stopped the body (the floor's friction alone
+  // would take 0.2 m/s of its 2 m/s), the platen moved, the coal yielded.
+  double momentum = 0, mass = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    momentum += a.mass[i] * a.v[i].x();
+    mass += a.mass[i];
+  }
+  CHECK(momentum / mass > -1.0);
+  CHECK(std::abs(plane.platen_displacement()[0]) > 0.01);
+  CHECK(*std::max_element(a.plastic_strain.begin(), a.plastic_strain.end()) > 0);
+  const Energies e2 = plane.energies(), e3 = solid.energies();
+  CHECK(e2.walls > 0);
+  CHECK(std::abs(e2.external) > 0);
+  CHECK(e3.kinetic == Approx(0.2 * e2.kinetic).epsilon(1e-8));
+  CHECK(e3.walls == Approx(0.2 * e2.walls).epsilon(1e-8));
+  CHECK(e3.external == Approx(0.2 * e2.external).epsilon(1e-8));
   CHECK(e3.total() == Approx(0.2 * e2.total()).epsilon(1e-8).margin(1e-9 * 0.2 * e2.kinetic));
 }
 
