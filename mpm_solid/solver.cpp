@@ -496,7 +496,7 @@ void Solver<Dim>::smooth_dilatation() {
         if (node[1] > 0) smoothed += s.weight[k] * node[0] / node[1];
       }
       Mat<Dim>& l = p.velocity_gradient[i];
-      l.diagonal().array() += 0.5 * (smoothed - l.trace());
+      l.diagonal().array() += (smoothed - l.trace()) / Dim;
     }
   }
 }
