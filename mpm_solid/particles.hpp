@@ -35,8 +35,8 @@ struct Particles {
   // Fields only some scenes need: empty unless created (by need_*, at their
   // initial values) for a material, a load or another program that uses them;
   // a scene that names none of those carries none of them.
-  std::vector<Vec<Dim>> external_force;     // set by another program [N per m]
-  std::vector<Vec<Dim>> surface_force;      // boundary tractions of the scene [N per m]
+  std::vector<Vec<Dim>> external_force;     // set by another program [N; N per m in 2D]
+  std::vector<Vec<Dim>> surface_force;      // boundary tractions of the scene [N; N per m in 2D]
   // Isotropic pressure another program adds to the total stress (alpha p of a
   // pore fluid) [Pa].
   std::vector<double> pore_pressure;

@@ -389,7 +389,7 @@ class Solver {
   std::size_t removed_ = 0;
   Energies dissipated_;  // only the accumulated members are used
   bool settled_ = false;  // a settling stage ran: its supports are gone
-  // Of the settling stage so far: the largest kinetic energy and the last [J/m].
+  // Of the settling stage so far: the largest kinetic energy and the last [J; J/m in 2D].
   double settling_peak_ = 0, settling_kinetic_ = 0;
 };
 

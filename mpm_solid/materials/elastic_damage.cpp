@@ -487,7 +487,7 @@ std::unique_ptr<Material<Dim>> read(const scene::Table& m, const MaterialContext
                                                 "sets the stable step",
                    same_as_strength, Range::at_least(1)}),
         h->has("grain_size")
-            ? std::optional(h->quantity({"grain_size", "side of the squares of coal that share one draw (a grid "
+            ? std::optional(h->quantity({"grain_size", "side of the squares (cubes in 3D) of coal that share one draw (a grid "
                                                        "through the origin): the random field's correlation "
                                                        "length, so that refining the particles keeps the same "
                                                        "coal; without it each particle draws its own, and a finer "

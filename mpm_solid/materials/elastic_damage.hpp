@@ -75,7 +75,7 @@ struct DamageParameters {
   // Each particle draws its own factors unless a grain size is given: the
   // random field's correlation length is then the particle spacing, so a
   // finer grid makes another, finer-grained coal. With a grain size g [m]
-  // the particles whose initial positions lie in one g x g square of a grid
+  // the particles whose initial positions lie in one g x g square (a cube in 3D) of a grid
   // through the origin share its draw (the square's indices replace the
   // particle's id in the hash), and every resolution finer than g sees the
   // same coal.
