@@ -35,10 +35,10 @@ int coupled_dimension(scene::Table root);
 // unused keys), and with Biot storage resolves the window pressure by the
 // stability analysis, refusing (scene::Refusal) a scheme the scene names that
 // cannot be stable at its window.
-template <int Dim = 2>
+template <int Dim>
 CoupledSetup<Dim> read_coupled_setup(scene::Table root);
 // The same without that resolution: what the scene says, as it says it.
-template <int Dim = 2>
+template <int Dim>
 CoupledSetup<Dim> read_coupled_scene(scene::Table root);
 
 // The poroelastic regime of every pair of MPM material (a heterogeneous one's

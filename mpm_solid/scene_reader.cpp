@@ -390,19 +390,22 @@ template <int Dim>
 BodyShape<Dim> read_body_shape(const scene::Table& b) {
   BodyShape<Dim> shape;
   if (b.has("polygon")) {
-    if constexpr (Dim == 3) b.fail("polygon", "a polygon is a 2D body; a 3D body is a box (box_min, box_max) or a "
-                                              "sphere (centre, radius)");
-    for (const auto& v : b.quantity_points({"polygon", "vertices [[\"x m\", \"y m\"], ...] in order"}, units::length, 2))
-      shape.polygon.emplace_back(v[0], v[1]);
-    if (shape.polygon.size() < 3) b.fail("polygon", "a polygon needs at least 3 vertices");
-    if (const auto crossing = crossing_edges(shape.polygon))
-      b.fail("polygon", fmt::format("the polygon crosses itself: its edge from vertex {} meets its edge from "
-                                    "vertex {} (vertices count from 0)",
-                                    crossing->first, crossing->second));
-    shape.lo = shape.hi = shape.polygon[0].template head<Dim>();
-    for (const auto& v : shape.polygon) {
-      shape.lo = shape.lo.cwiseMin(v.template head<Dim>());
-      shape.hi = shape.hi.cwiseMax(v.template head<Dim>());
+    if constexpr (Dim == 3) {
+      b.fail("polygon", "a polygon is a 2D body; a 3D body is a box (box_min, box_max) or a sphere (centre, radius)");
+    } else {
+      for (const auto& v :
+           b.quantity_points({"polygon", "vertices [[\"x m\", \"y m\"], ...] in order"}, units::length, 2))
+        shape.polygon.emplace_back(v[0], v[1]);
+      if (shape.polygon.size() < 3) b.fail("polygon", "a polygon needs at least 3 vertices");
+      if (const auto crossing = crossing_edges(shape.polygon))
+        b.fail("polygon", fmt::format("the polygon crosses itself: its edge from vertex {} meets its edge from "
+                                      "vertex {} (vertices count from 0)",
+                                      crossing->first, crossing->second));
+      shape.lo = shape.hi = shape.polygon[0];
+      for (const auto& v : shape.polygon) {
+        shape.lo = shape.lo.cwiseMin(v);
+        shape.hi = shape.hi.cwiseMax(v);
+      }
     }
   } else if (b.has("radius")) {
     if constexpr (Dim == 2) b.fail("radius", "a sphere is a 3D body; a 2D body is a box or a polygon");

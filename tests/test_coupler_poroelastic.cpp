@@ -214,7 +214,7 @@ TEST_CASE("Terzaghi on a ten times stiffer column: Aitken and IQN-ILS beat const
     auto doc = scene::Document::load(std::string(OUTBURST_SOURCE_DIR) + "/cases/terzaghi/terzaghi.toml",
                                      with({fmt::format("coupling.acceleration=\"{}\"", acceleration),
                                            "scene.end_time=\"0.2 s\""}));
-    coupling::CoupledModel model(coupling::read_coupled_setup(doc->root()));
+    coupling::CoupledModel model(coupling::read_coupled_setup<2>(doc->root()));
     while (model.coupling().time() < 0.2 - 1e-12) model.advance(0.2);
     return mean_iterations(model);
   };
@@ -227,7 +227,7 @@ TEST_CASE("Terzaghi on a ten times stiffer column: Aitken and IQN-ILS beat const
   const auto largest_pressure = [&](std::vector<std::string> overrides) {
     auto doc = scene::Document::load(std::string(OUTBURST_SOURCE_DIR) + "/cases/terzaghi/terzaghi.toml",
                                      with(overrides));
-    coupling::CoupledModel model(coupling::read_coupled_setup(doc->root()));
+    coupling::CoupledModel model(coupling::read_coupled_setup<2>(doc->root()));
     double worst = 0;
     try {
       while (model.coupling().time() < 0.5 - 1e-12) {
@@ -262,7 +262,7 @@ struct MandelResult {
 // Runs cases/mandel with the overrides, checking at t = 0.025 ... 0.3 s.
 MandelResult run_mandel(const std::vector<std::string>& overrides) {
   auto doc = scene::Document::load(std::string(OUTBURST_SOURCE_DIR) + "/cases/mandel/mandel.toml", overrides);
-  coupling::CoupledModel model(coupling::read_coupled_setup(doc->root()));
+  coupling::CoupledModel model(coupling::read_coupled_setup<2>(doc->root()));
   doc->reject_unused();
   // The scene's values (see its header).
   const Mandel exact(1.0, 1.0, 1e4, 1e7, 0.0, 1e-7, 1.0, 1.833e-10 / 1e-3);

@@ -151,17 +151,17 @@ TEST_CASE("a scheme predicted unstable is replaced (auto) or refused before the 
   // Auto: the ramp is predicted to grow, so the end pressure (and the
   // fixed-stress split) is chosen.
   auto doc = terzaghi({stiff_fluid});
-  const auto setup = coupling::read_coupled_setup(doc->root());
+  const auto setup = coupling::read_coupled_setup<2>(doc->root());
   CHECK(setup.coupling.window_pressure == Pressure::end);
   CHECK(setup.coupling.fixed_stress_split == true);
   // The scene's own regime keeps the ramp.
   auto plain = terzaghi({});
-  CHECK(coupling::read_coupled_setup(plain->root()).coupling.window_pressure == Pressure::ramp);
+  CHECK(coupling::read_coupled_setup<2>(plain->root()).coupling.window_pressure == Pressure::ramp);
   // Named explicitly, the ramp is refused, with the alternative.
   auto ramp = terzaghi({stiff_fluid, "coupling.window_pressure=\"ramp\""});
-  REQUIRE_THROWS_AS(coupling::read_coupled_setup(ramp->root()), scene::Refusal);
+  REQUIRE_THROWS_AS(coupling::read_coupled_setup<2>(ramp->root()), scene::Refusal);
   try {
-    coupling::read_coupled_setup(ramp->root());
+    coupling::read_coupled_setup<2>(ramp->root());
   } catch (const scene::Refusal& e) {
     const std::string message = e.what();
     CHECK_THAT(message, Catch::Contains("coupling.window_pressure") && Catch::Contains("grows by 76") &&
@@ -169,17 +169,17 @@ TEST_CASE("a scheme predicted unstable is replaced (auto) or refused before the 
   }
   // So is a one-pass scheme no window pressure saves.
   auto explicit_scheme = terzaghi({"coupling.scheme=\"explicit\"", "coupling.window=\"2.5 ms\""});
-  CHECK_THROWS_AS(coupling::read_coupled_setup(explicit_scheme->root()), scene::Refusal);
+  CHECK_THROWS_AS(coupling::read_coupled_setup<2>(explicit_scheme->root()), scene::Refusal);
   // Unless asked to run it anyway (to measure it).
   auto allowed = terzaghi({"coupling.scheme=\"explicit\"", "coupling.window=\"2.5 ms\"", "coupling.allow_unstable=true"});
-  CHECK_NOTHROW(coupling::read_coupled_setup(allowed->root()));
+  CHECK_NOTHROW(coupling::read_coupled_setup<2>(allowed->root()));
 }
 
 TEST_CASE("the predicted growth of the ramp is the growth a Terzaghi run with a nearly incompressible fluid shows",
           "[coupler][stability]") {
   auto doc = terzaghi({stiff_fluid, "coupling.window_pressure=\"ramp\"", "coupling.allow_unstable=true",
                        "scene.end_time=\"0.07 s\""});
-  auto setup = coupling::read_coupled_setup(doc->root());
+  auto setup = coupling::read_coupled_setup<2>(doc->root());
   double predicted = -1e300;
   for (const auto& r : coupling::poroelastic_regimes(setup))
     predicted = std::max(predicted, growth(r, {true, false, Pressure::ramp, setup.coupling.window}).rate);
@@ -202,10 +202,10 @@ TEST_CASE("a fixed MPM time step in a coupled scene is checked against the stabl
           "[coupler][stability]") {
   // Terzaghi's column: P wave 110 m/s on 0.05 m cells, a stable step of 4.5e-4 s at Courant 1.
   auto ok = terzaghi({"mpm.time_step=\"1e-4 s\""});
-  CHECK_NOTHROW(coupling::read_coupled_setup(ok->root()));
+  CHECK_NOTHROW(coupling::read_coupled_setup<2>(ok->root()));
   auto too_long = terzaghi({"mpm.time_step=\"1e-3 s\""});
   try {
-    coupling::read_coupled_setup(too_long->root());
+    coupling::read_coupled_setup<2>(too_long->root());
     FAIL("a step above the stable one was accepted");
   } catch (const scene::Error& e) {
     const std::string message = e.what();

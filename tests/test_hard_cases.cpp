@@ -51,7 +51,7 @@ Outcome run(const std::string& scene, const std::vector<std::string>& overrides,
   Outcome o;
   std::optional<coupling::CoupledSetup<2>> setup;
   try {
-    setup = coupling::read_coupled_setup(doc->root());
+    setup = coupling::read_coupled_setup<2>(doc->root());
   } catch (const scene::Refusal& e) {
     std::printf("    refused: %s\n", e.what());
     o.refused = true;

@@ -49,7 +49,7 @@ TEST_CASE("a coupled scene whose particles leave seepage cells reading as open s
   const std::string scene = std::string(OUTBURST_SOURCE_DIR) + "/cases/outburst/outburst.toml";
   const auto setup = [&](const std::string& per_cell) {
     auto doc = scene::Document::load(scene, {"mpm.bodies[0].particles_per_cell=" + per_cell});
-    return coupling::read_coupled_setup(doc->root());
+    return coupling::read_coupled_setup<2>(doc->root());
   };
   // 1/3 m cells: 2 and 3 particles per cell fill every 0.5 m seepage cell to
   // 100 % and 79 % at least; 1 per cell (1/3 m apart) some to 44 %, below
@@ -64,7 +64,7 @@ TEST_CASE("a coupled scene whose seepage mesh reaches past the MPM grid is refus
   const std::string scene = std::string(OUTBURST_SOURCE_DIR) + "/cases/gas_face/gas_face.toml";
   const auto setup = [&](const std::string& origin) {
     auto doc = scene::Document::load(scene, {"seepage.mesh.origin=" + origin});
-    return coupling::read_coupled_setup(doc->root());
+    return coupling::read_coupled_setup<2>(doc->root());
   };
   REQUIRE_NOTHROW(setup(R"(["2 m", "1 m"])"));
   // Before: accepted, every cell read open and the gas left in the first window.
