@@ -308,6 +308,14 @@ def steepest_drop(p, distance):
     return slope[k], distance[k]
 
 
+def drop_table(g, steps):
+    """The steepest drops (rows of t, drop, where) at the given rows, as a table across."""
+    return ["| t [s] | " + " | ".join(f"{t:.3g}" for t in g[steps, 0]) + " |",
+            "|---|" + "---|" * len(steps),
+            "| drop [MPa/m] | " + " | ".join(f"{v:.3g}" for v in g[steps, 1]) + " |",
+            "| at [m] | " + " | ".join(f"{v:.3g}" for v in g[steps, 2]) + " |"]
+
+
 def bin_counts(x0, x, edges):
     """The particles in each bin of the edges (one array per coordinate, the
     first coordinates' in order) at t = 0 (x0) and now (x)."""
@@ -494,10 +502,7 @@ def write_report(run, args, gradients, path):
         "",
         "Steepest pressure drop on the tunnel axis over time (where it sits: metres into the seam):",
         "",
-        "| t [s] | " + " | ".join(f"{t:.3g}" for t in g[steps, 0]) + " |",
-        "|---|" + "---|" * len(steps),
-        "| drop [MPa/m] | " + " | ".join(f"{v:.3g}" for v in g[steps, 1]) + " |",
-        "| at [m] | " + " | ".join(f"{v:.3g}" for v in g[steps, 2]) + " |",
+        *drop_table(g, steps),
         "",
         "## Energy budget (J per m of depth, at the end)",
         "",
