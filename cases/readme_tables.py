@@ -715,6 +715,22 @@ def outburst_3d_headline(heading, plane):
         f"its folder {p['run']}.")
 
 
+@block("outburst 3d resolution", "cases/outburst_3d/report/headline.csv", "cases/outburst_3d/report/headline_fine.csv",
+       "cases/outburst_3d/report/headline_plane.csv")
+def outburst_3d_resolution(coarse, fine, plane):
+    """The 3D heading on cells of 1/2 m and of 1/3 m (run.sh --fine) beside the plane run."""
+    from .outburst_3d.report import ratios, resolution
+    if len(coarse) != 1 or len(fine) != 1 or len(plane) != 1:
+        raise BlockError(f"{len(coarse)} coarse, {len(fine)} fine and {len(plane)} plane rows, not one each")
+
+    def numbers(row):
+        return {k: (float(v) if v and k not in ("version", "run") else v) for k, v in row.items()}
+
+    c, f, p = numbers(coarse[0]), numbers(fine[0]), numbers(plane[0])
+    return resolution(c, f, p) + [""] + wrap(
+        f"Fine over coarse: {ratios(f, c)}. The fine run's build: {f['version']}.")
+
+
 def blocks_of(path, lines):
     """(name, first line index inside, index of the end marker) of each block in a README's lines."""
     found, open_at = [], None

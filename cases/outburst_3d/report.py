@@ -28,8 +28,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
-from ..outburst.report import (MPA, PAPER, ENERGY_NOTE, Run, axis_row, bin_counts, ejection_start, energy_table,
-                               five, particle_figure, pile_and_seam_figure, pile_heights, pressure_figure,
+from ..outburst.report import (MPA, PAPER, ENERGY_NOTE, Run, axis_row, bin_counts, drop_table, ejection_start,
+                               energy_table, five, particle_figure, pile_and_seam_figure, pile_heights, pressure_figure,
                                pressure_profile_figure, section, tracer_figures, tunnel)
 from ..runs import write_rows
 from ..units import value
@@ -224,6 +224,20 @@ def comparison(h, plane=None):
     return lines
 
 
+def resolution(coarse, fine, plane=None):
+    """The 3D heading at two cell sizes side by side (and the plane run's), and
+    how far each headline number moved from the coarse cells to the fine."""
+    def cells(h):
+        return f"3D, cells of {h['cell_m']:.3g} m"
+
+    lines = [f"| quantity | {cells(coarse)} | {cells(fine)} | " + ("plane case | " if plane else "") + "paper |",
+             "|---|---|---|" + ("---|" if plane else "") + "---|"]
+    for label, ours, theirs, paper in ROWS:
+        lines.append(f"| {label} | {ours(coarse)} | {ours(fine)} | " + (f"{theirs(plane)} | " if plane else "")
+                     + f"{paper} |")
+    return lines
+
+
 def ratios(h, plane):
     """The 3D numbers over the plane's, volumes per metre of the heading's width."""
     pairs = [("centre speed", "centre_m_per_s"), ("run-out", "farthest_m"),
@@ -285,10 +299,7 @@ def write_report(run, h, plane, plane_dir, gradients, path):
         "Steepest pressure drop on the heading's axis (y at mid-height, z = 0) over time (where it sits: metres into "
         "the seam):",
         "",
-        "| t [s] | " + " | ".join(f"{t:.3g}" for t in g[steps, 0]) + " |",
-        "|---|" + "---|" * len(steps),
-        "| drop [MPa/m] | " + " | ".join(f"{v:.3g}" for v in g[steps, 1]) + " |",
-        "| at [m] | " + " | ".join(f"{v:.3g}" for v in g[steps, 2]) + " |",
+        *drop_table(g, steps),
         "",
         "## Energy budget (J, the half model, at the end)",
         "",
