@@ -699,6 +699,11 @@ def cryer_resolution(rows):
     return lines
 
 
+def headline_numbers(row):
+    """A 3D report's headline row (cases.outburst_3d.report) with its numbers as numbers."""
+    return {k: (float(v) if v and k not in ("version", "run") else v) for k, v in row.items()}
+
+
 @block("outburst 3d headline", "cases/outburst_3d/report/headline.csv", "cases/outburst_3d/report/headline_plane.csv")
 def outburst_3d_headline(heading, plane):
     """The 3D heading's report table (cases.outburst_3d.report) beside the plane run's, and which runs they are."""
@@ -706,11 +711,8 @@ def outburst_3d_headline(heading, plane):
     if len(heading) != 1 or len(plane) != 1:
         raise BlockError(f"{len(heading)} 3D and {len(plane)} plane rows, not one each")
 
-    def numbers(row):
-        return {k: (float(v) if v and k not in ("version", "run") else v) for k, v in row.items()}
-
-    h, p = numbers(heading[0]), numbers(plane[0])
-    return comparison(h, p) + [""] + wrap(
+    h, p = headline_numbers(heading[0]), headline_numbers(plane[0])
+    return comparison([("3D heading", h)], p) + [""] + wrap(
         f"3D over plane: {ratios(h, p)}. The 3D run's build: {h['version']}; the plane run's: {p['version']}, "
         f"its folder {p['run']}.")
 
@@ -719,15 +721,12 @@ def outburst_3d_headline(heading, plane):
        "cases/outburst_3d/report/headline_plane.csv")
 def outburst_3d_resolution(coarse, fine, plane):
     """The 3D heading on cells of 1/2 m and of 1/3 m (run.sh --fine) beside the plane run."""
-    from .outburst_3d.report import ratios, resolution
+    from .outburst_3d.report import comparison, ratios
     if len(coarse) != 1 or len(fine) != 1 or len(plane) != 1:
         raise BlockError(f"{len(coarse)} coarse, {len(fine)} fine and {len(plane)} plane rows, not one each")
 
-    def numbers(row):
-        return {k: (float(v) if v and k not in ("version", "run") else v) for k, v in row.items()}
-
-    c, f, p = numbers(coarse[0]), numbers(fine[0]), numbers(plane[0])
-    return resolution(c, f, p) + [""] + wrap(
+    c, f, p = (headline_numbers(row[0]) for row in (coarse, fine, plane))
+    return comparison([(f"3D, cells of {h['cell_m']:.3g} m", h) for h in (c, f)], p) + [""] + wrap(
         f"Fine over coarse: {ratios(f, c)}. The fine run's build: {f['version']}.")
 
 

@@ -215,26 +215,15 @@ ROWS = [
 ]
 
 
-def comparison(h, plane=None):
-    """The table of the 3D numbers (h) beside the plane run's, if given, and the paper's."""
-    lines = ["| quantity | 3D heading | " + ("plane case | " if plane else "") + "paper |",
-             "|---|---|" + ("---|" if plane else "") + "---|"]
+def comparison(runs, plane=None):
+    """The table of 3D runs' numbers (runs: pairs of a column title and a run's
+    headline) beside the plane run's, if given, and the paper's."""
+    lines = ["| quantity | " + "".join(f"{title} | " for title, _ in runs) + ("plane case | " if plane else "")
+             + "paper |",
+             "|---|" + "---|" * len(runs) + ("---|" if plane else "") + "---|"]
     for label, ours, theirs, paper in ROWS:
-        lines.append(f"| {label} | {ours(h)} | " + (f"{theirs(plane)} | " if plane else "") + f"{paper} |")
-    return lines
-
-
-def resolution(coarse, fine, plane=None):
-    """The 3D heading at two cell sizes side by side (and the plane run's), and
-    how far each headline number moved from the coarse cells to the fine."""
-    def cells(h):
-        return f"3D, cells of {h['cell_m']:.3g} m"
-
-    lines = [f"| quantity | {cells(coarse)} | {cells(fine)} | " + ("plane case | " if plane else "") + "paper |",
-             "|---|---|---|" + ("---|" if plane else "") + "---|"]
-    for label, ours, theirs, paper in ROWS:
-        lines.append(f"| {label} | {ours(coarse)} | {ours(fine)} | " + (f"{theirs(plane)} | " if plane else "")
-                     + f"{paper} |")
+        lines.append(f"| {label} | " + "".join(f"{ours(h)} | " for _, h in runs)
+                     + (f"{theirs(plane)} | " if plane else "") + f"{paper} |")
     return lines
 
 
@@ -288,7 +277,7 @@ def write_report(run, h, plane, plane_dir, gradients, path):
         f"depth; per metre of seam width, over the {2 * h['seam_far_side_m']:g} m between headings. The tracers "
         "are the particles nearest the face's top, middle and bottom on the heading's axis.",
         "",
-        *comparison(h, plane),
+        *comparison([("3D heading", h)], plane),
         "",
     ]
     if plane:
