@@ -11,7 +11,6 @@ one ulp must differ: the comparison sees that much. Then the refusals (exit code
 overrides, version or build, and a fresh run into a folder that holds one.
 
 usage: restart.py BUILD_DIR SOURCE_DIR WORK_DIR [SEED]"""
-import csv
 import os
 import random
 import re
@@ -27,12 +26,8 @@ import h5py
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from run_folder import leftovers, listed  # noqa: E402
+from run_folder import compare_checkpoints, compare_histories, compare_listed, leftovers, listed  # noqa: E402
 
-WALL_CLOCK = {"seepage_s", "solid_s", "coupler_s"}  # coupling.csv: seconds each part took
-# Checkpoint datasets that hold wall-clock seconds, or the length of a CSV
-# with such columns.
-WALL_CLOCK_STATE = re.compile(r"(first|second|coupler)_seconds$|coupling_log/bytes$")
 
 # stops: (signal, stage) pairs; the stage is "settling" or "run".
 Case = namedtuple("Case", "name program scene overrides threads stops indexes histories")
@@ -186,70 +181,16 @@ def stop_in_time(line, out, sig, stage, delay):
     return [f"{sig.name} missed the {stage} stage four times: lengthen it"]
 
 
-def value(dataset):
-    """A dataset's shape, type and bytes (text as text)."""
-    data = dataset[()]
-    if isinstance(data, (bytes, str)):
-        return data
-    data = np.asarray(data)
-    return data.shape, data.dtype.str, data.tobytes()
-
-
-def datasets(path, skip=None):
-    found = {}
-    with h5py.File(path, "r") as f:
-        def visit(name, obj):
-            if isinstance(obj, h5py.Dataset) and not (skip and skip.search(name)):
-                found[name] = value(obj)
-        f.visititems(visit)
-        found["stage attribute"] = f.attrs.get("stage")
-    return found
-
-
 def compare_snapshots(reference, other, index):
-    """Differences between the snapshots two folders list in `index`."""
-    times_a, files_a = listed(reference, index)
-    times_b, files_b = listed(other, index)
-    if times_a != times_b or files_a != files_b:
-        return [f"{index}: lists {len(times_b)} times {times_b[-3:]}, expected {len(times_a)} {times_a[-3:]}"]
-    failures = []
-    for name in files_a:
-        a, b = datasets(os.path.join(reference, name)), datasets(os.path.join(other, name))
-        failures += [f"{name}:{d}" for d in differences(a, b)]
+    """Differences between the snapshots two folders list in `index`, and
+    snapshot files the restarted run left beyond them."""
+    failures = compare_listed(reference, other, index)
     # The killed run's snapshots after its checkpoint are gone or rewritten.
+    _, files = listed(reference, index)
     written = sorted(n for n in os.listdir(other) if re.fullmatch(index[:-5] + r"_\d{6}\.h5", n))
-    if written != [n for n in files_a if re.fullmatch(r".*_\d{6}\.h5", n)]:
+    if written != [n for n in files if re.fullmatch(r".*_\d{6}\.h5", n)]:
         failures.append(f"{index}: the folder holds snapshot files {written[-3:]} beyond those listed")
     return failures
-
-
-def differences(a, b):
-    if a.keys() != b.keys():
-        return [f"datasets {sorted(set(a) ^ set(b))} in one only"]
-    return [f"{key} differs" for key in sorted(a) if a[key] != b[key]]
-
-
-def compare_checkpoints(reference, other):
-    """The whole state at the last checkpoint, but for wall-clock seconds."""
-    a = datasets(os.path.join(reference, "checkpoint.h5"), WALL_CLOCK_STATE)
-    b = datasets(os.path.join(other, "checkpoint.h5"), WALL_CLOCK_STATE)
-    return [f"checkpoint.h5: {d}" for d in differences(a, b)]
-
-
-def rows(path):
-    with open(path) as f:
-        return [{k: v for k, v in row.items() if k not in WALL_CLOCK} for row in csv.DictReader(f)]
-
-
-def compare_histories(reference, other, history):
-    a, b = rows(os.path.join(reference, history)), rows(os.path.join(other, history))
-    if len(a) != len(b):
-        return [f"{history}: {len(b)} rows, expected {len(a)}"]
-    for k, (ra, rb) in enumerate(zip(a, b)):
-        if ra != rb:
-            column = next(c for c in ra if ra[c] != rb.get(c))
-            return [f"{history}: row {k + 1} differs in {column}: {rb.get(column)} instead of {ra[column]}"]
-    return []
 
 
 def compare(reference, other, case):

@@ -1,0 +1,67 @@
+#!/usr/bin/env bash
+# Whether this checkout computes what commit BASE computed, bit for bit: both
+# are built without compiler-placed fused multiply-adds
+# (-DOUTBURST_NO_FP_CONTRACTION=ON, whose placement moves with inlining), each
+# scene is run by both on one thread, and scripts/same-results.py compares the
+# two run folders (every snapshot dataset, every CSV row but wall-clock
+# columns, the last checkpoint). For a refactor that should change no
+# arithmetic; a change that moves results on purpose shows here, and the
+# commits either side of it should each compare equal.
+#
+# Usage: scripts/compare-builds.sh BASE [SCENE...]
+#   SCENE: a scene file under cases/ (default: every plane scene shipped, the
+#   outburst to its end, 1 s). Work folder: $COMPARE_DIR (default
+#   /tmp/outburst-compare); builds are kept there and rebuilt incrementally.
+# Exit 0 when every scene's results are equal, 1 when one differs.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+[ $# -ge 1 ] || { sed -n '2,16p' "$0"; exit 2; }
+base=$(git rev-parse --verify "$1^{commit}") || { echo "$1: not a commit" >&2; exit 2; }
+shift
+scenes=("$@")
+[ ${#scenes[@]} -gt 0 ] || scenes=(cases/bar/bar.toml cases/drainage/drainage.toml
+  cases/elastic_block/elastic_block.toml cases/granular_collapse/granular_collapse.toml
+  cases/gas_face/gas_face.toml cases/terzaghi/terzaghi.toml cases/mandel/mandel.toml
+  cases/outburst/outburst.toml)
+work=${COMPARE_DIR:-/tmp/outburst-compare}
+mkdir -p "$work"
+if [ ! -d "$work/base-src" ]; then
+  git worktree add --detach "$work/base-src" "$base" > /dev/null
+else
+  git -C "$work/base-src" checkout --quiet --detach "$base"
+fi
+
+build() {  # build SOURCE_DIR BUILD_DIR
+  cmake -S "$1" -B "$2" -DCMAKE_BUILD_TYPE=Release -DOUTBURST_NATIVE=ON -DOUTBURST_NO_FP_CONTRACTION=ON \
+    -DOUTBURST_BUILD_TESTS=OFF -DOUTBURST_BUILD_BENCHMARKS=OFF > "$2.configure.log"
+  cmake --build "$2" --target mpm-solid seepage-fe outburst -j "$(nproc)" > "$2.build.log" ||
+    { echo "building $1 failed: $2.build.log" >&2; exit 2; }
+}
+echo "building $(git -C "$work/base-src" log -1 --format='%h %s' | cut -c1-72) ..."
+build "$work/base-src" "$work/base-build"
+echo "building this checkout ($(git describe --always --dirty)) ..."
+build "$PWD" "$work/head-build"
+
+# The program a scene names: [scene] solvers.
+program() {
+  local solvers
+  solvers=$(grep -m1 '^solvers' "$1")
+  case "$solvers" in
+    *seepage*mpm* | *mpm*seepage*) echo coupler/outburst ;;
+    *mpm*) echo mpm_solid/mpm-solid ;;
+    *) echo seepage_fe/seepage-fe ;;
+  esac
+}
+
+differ=0
+for scene in "${scenes[@]}"; do
+  name=$(basename "$scene" .toml)
+  p=$(program "$scene")
+  for side in base head; do
+    mkdir -p "$work/runs/$side"
+    OMP_NUM_THREADS=1 "$work/$side-build/$p" "$scene" -q -j 1 --overwrite -o "$work/runs/$side/$name" \
+      > "$work/runs-$side-$name.log" 2>&1 || { echo "$name: $side run failed: $work/runs-$side-$name.log" >&2; exit 2; }
+  done
+  /usr/bin/python3 scripts/same-results.py "$work/runs/base/$name" "$work/runs/head/$name" || differ=1
+done
+exit $differ
