@@ -91,6 +91,6 @@ TEST_CASE("one-way: a column under a linear gas pressure settles to the analytic
   std::printf("\none-way column: worst |sigma'_yy - f (H - y)| / (f H) = %.2e, worst displacement error / u_top = "
               "%.2e (u_top = %.3g mm)\n",
               stress_error / (f * H), displacement_error / top_u, 1e3 * top_u);
-  CHECK(stress_error < 0.03 * f * H);
-  CHECK(displacement_error < 0.01 * top_u);
+  CHECK(stress_error < 0.01 * f * H);
+  CHECK(displacement_error < 0.003 * top_u);
 }
