@@ -20,29 +20,20 @@ std::vector<double> nonlocal_average(const std::vector<Vec<Dim>>& x, const std::
   std::vector<double> average(members.size());
   if (n == 0) return average;
   // Bins of side R: every neighbour of a particle lies in its bin or one of
-  // the 3^Dim - 1 around it. A bin is a key of two 32-bit coordinates (three
-  // of 21 bits in 3D).
+  // the 3^Dim - 1 around it.
   using Bin = std::array<std::int64_t, Dim>;
   const auto bin_of = [&](const Vec<Dim>& v) {
     Bin b;
     for (int d = 0; d < Dim; ++d) b[d] = static_cast<std::int64_t>(std::floor(v[d] / radius));
     return b;
   };
-  const auto key = [](const Bin& b) {
-    if constexpr (Dim == 2) {
-      return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(b[0])) << 32) | static_cast<std::uint32_t>(b[1]);
-    } else {
-      const auto bits = [](std::int64_t c) { return static_cast<std::uint64_t>(c) & 0x1fffffu; };
-      return (bits(b[0]) << 42) | (bits(b[1]) << 21) | bits(b[2]);
-    }
-  };
   std::vector<std::pair<std::uint64_t, int>> binned(members.size());
 #pragma omp parallel for schedule(static)
-  for (int k = 0; k < n; ++k) binned[k] = {key(bin_of(x[members[k]])), k};
+  for (int k = 0; k < n; ++k) binned[k] = {bin_key<Dim>(bin_of(x[members[k]])), k};
   std::sort(binned.begin(), binned.end());
   const double r2 = radius * radius;
   const auto gather = [&](const Vec<Dim>& xk, const Bin& b, double& weighted, double& weights) {
-    const std::uint64_t bin = key(b);
+    const std::uint64_t bin = bin_key<Dim>(b);
     auto it = std::lower_bound(binned.begin(), binned.end(), std::pair<std::uint64_t, int>{bin, 0});
     for (; it != binned.end() && it->first == bin; ++it) {
       const int j = it->second;

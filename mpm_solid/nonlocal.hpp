@@ -7,11 +7,26 @@
 // uniform field stays uniform at a free surface, where a particle has fewer
 // neighbours.
 
+#include <array>
+#include <cstdint>
 #include <vector>
 
 #include "mpm_solid/grid.hpp"
 
 namespace outburst::mpm {
+
+// One 64-bit key for the integer coordinates of a square (a cube in 3D), to
+// sort or hash bins by: two 32-bit coordinates in the plane, three of 21 bits
+// in 3D, so that two bins share a key only two million bins apart.
+template <int Dim>
+std::uint64_t bin_key(const std::array<std::int64_t, Dim>& c) {
+  if constexpr (Dim == 2) {
+    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(c[0])) << 32) | static_cast<std::uint32_t>(c[1]);
+  } else {
+    const auto bits = [](std::int64_t i) { return static_cast<std::uint64_t>(i) & 0x1fffffu; };
+    return (bits(c[0]) << 42) | (bits(c[1]) << 21) | bits(c[2]);
+  }
+}
 
 // The averages of value[k], the value of particle members[k] of weight
 // weight[k], over the members within `radius` of it [m] (itself included; its

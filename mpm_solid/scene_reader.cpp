@@ -327,7 +327,9 @@ Grid<Dim> read_grid(const scene::Table& s) {
   return gr;
 }
 
-// Nodes of a grid with its ghost layers, for the memory estimates.
+// Nodes of a grid with its ghost layers, for the memory estimates: counted
+// in double, unlike Grid::num_nodes, so that a grid too large for any
+// machine is refused by its estimate rather than wrapped around.
 template <int Dim>
 double grid_nodes(const Grid<Dim>& gr) {
   double nodes = 1;

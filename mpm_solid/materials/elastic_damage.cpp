@@ -1,6 +1,7 @@
 #include "mpm_solid/materials/elastic_damage.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -150,15 +151,9 @@ double weibull_modulus_scale(const DamageParameters::Heterogeneity& h, std::int6
 template <int Dim>
 std::int64_t DamageParameters::Heterogeneity::key(std::int64_t id, const Vec<Dim>& x0) const {
   if (!grain_size) return id;
-  const auto index = [&](double x) { return static_cast<std::uint32_t>(static_cast<std::int32_t>(std::floor(x / *grain_size))); };
-  if constexpr (Dim == 2) {
-    return static_cast<std::int64_t>((static_cast<std::uint64_t>(index(x0[0])) << 32) | index(x0[1]));
-  } else {
-    // 21 bits of each index: grains across two million grain sizes before
-    // two share a key.
-    const auto bits = [&](double x) { return static_cast<std::uint64_t>(index(x) & 0x1fffffu); };
-    return static_cast<std::int64_t>((bits(x0[0]) << 42) | (bits(x0[1]) << 21) | bits(x0[2]));
-  }
+  std::array<std::int64_t, Dim> grain;
+  for (int d = 0; d < Dim; ++d) grain[d] = static_cast<std::int64_t>(std::floor(x0[d] / *grain_size));
+  return static_cast<std::int64_t>(bin_key<Dim>(grain));
 }
 
 template std::int64_t DamageParameters::Heterogeneity::key<2>(std::int64_t, const Vec<2>&) const;
