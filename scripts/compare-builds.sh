@@ -8,15 +8,25 @@
 # arithmetic; a change that moves results on purpose shows here, and the
 # commits either side of it should each compare equal.
 #
-# Usage: scripts/compare-builds.sh BASE [SCENE...]
-#   SCENE: a scene file under cases/ (default: every plane scene shipped, the
-#   outburst to its end, 1 s). Work folder: $COMPARE_DIR (default
-#   /tmp/outburst-compare); builds are kept there and rebuilt incrementally.
+# Usage: scripts/compare-builds.sh [--other COMMIT] BASE [SCENE...]
+#   --other: compare commit COMMIT with BASE instead of this checkout (to find
+#   which commit of a range moved a result).
+#   SCENE: a scene file, read from this checkout by both builds (default:
+#   every plane scene shipped, the outburst to its end, 1 s). Work folder:
+#   $COMPARE_DIR (default /tmp/outburst-compare); builds are kept there and
+#   rebuilt incrementally.
 # Exit 0 when every scene's results are equal, 1 when one differs.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-[ $# -ge 1 ] || { sed -n '2,16p' "$0"; exit 2; }
-base=$(git rev-parse --verify "$1^{commit}") || { echo "$1: not a commit" >&2; exit 2; }
+commit() { git rev-parse --verify --quiet "$1^{commit}" || { echo "$1: not a commit" >&2; exit 2; }; }
+other=
+if [ "${1:-}" = --other ]; then
+  [ $# -ge 2 ] || { echo "--other: expected a commit" >&2; exit 2; }
+  other=$(commit "$2")
+  shift 2
+fi
+[ $# -ge 1 ] || { sed -n '2,19p' "$0"; exit 2; }
+base=$(commit "$1")
 shift
 scenes=("$@")
 [ ${#scenes[@]} -gt 0 ] || scenes=(cases/bar/bar.toml cases/drainage/drainage.toml
@@ -25,11 +35,14 @@ scenes=("$@")
   cases/outburst/outburst.toml)
 work=${COMPARE_DIR:-/tmp/outburst-compare}
 mkdir -p "$work"
-if [ ! -d "$work/base-src" ]; then
-  git worktree add --detach "$work/base-src" "$base" > /dev/null
-else
-  git -C "$work/base-src" checkout --quiet --detach "$base"
-fi
+checkout() {  # checkout FOLDER COMMIT: a worktree of this repository at COMMIT
+  if [ ! -d "$1" ]; then
+    git worktree add --detach "$1" "$2" > /dev/null 2>&1
+  else
+    git -C "$1" checkout --quiet --detach "$2"
+  fi
+}
+checkout "$work/base-src" "$base"
 
 build() {  # build SOURCE_DIR BUILD_DIR
   cmake -S "$1" -B "$2" -DCMAKE_BUILD_TYPE=Release -DOUTBURST_NATIVE=ON -DOUTBURST_NO_FP_CONTRACTION=ON \
@@ -39,8 +52,14 @@ build() {  # build SOURCE_DIR BUILD_DIR
 }
 echo "building $(git -C "$work/base-src" log -1 --format='%h %s' | cut -c1-72) ..."
 build "$work/base-src" "$work/base-build"
-echo "building this checkout ($(git describe --always --dirty)) ..."
-build "$PWD" "$work/head-build"
+if [ -n "$other" ]; then
+  checkout "$work/other-src" "$other"
+  echo "building $(git -C "$work/other-src" log -1 --format='%h %s' | cut -c1-72) ..."
+  build "$work/other-src" "$work/head-build"
+else
+  echo "building this checkout ($(git describe --always --dirty)) ..."
+  build "$PWD" "$work/head-build"
+fi
 
 # The program a scene names: [scene] solvers.
 program() {
