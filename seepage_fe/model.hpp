@@ -60,6 +60,11 @@ struct Model {
 enum class TimeScheme { backward_euler, bdf2 };
 enum class NonlinearMethod { newton, picard };
 enum class LinearSolver { direct, cg, lagged };
+// How tightly conjugate gradients solve each Newton system: every one to
+// cg_tolerance, or by Eisenstat and Walker's forcing term (their choice 2,
+// SIAM J. Sci. Comput. 17, 1996): loosely while Newton is far from the
+// solution, to cg_tolerance as it converges.
+enum class Forcing { fixed, adaptive };
 
 struct Settings {
   TimeScheme scheme = TimeScheme::bdf2;
@@ -76,6 +81,7 @@ struct Settings {
   // move: lagged solves it as direct does.
   LinearSolver linear_solver = LinearSolver::direct;
   double cg_tolerance = 1e-8;
+  Forcing cg_forcing = Forcing::fixed;
   int cg_max_iterations = 5000;  // beyond them the step is cut
   int lag_max_iterations = 10;
 };

@@ -162,6 +162,17 @@ void read_settings(const scene::Table& s, Settings& st) {
                                 "1e-8", Range{0.0, 1.0, false, false}});
   else if (s.has("cg_tolerance"))
     s.fail("cg_tolerance", "applies to conjugate gradients only: set seepage.linear_solver = \"cg\" or \"lagged\"");
+  if (iterative)
+    st.cg_forcing = s.choice<Forcing>(
+        {"cg_forcing",
+         "how tightly conjugate gradients solve each Newton system: \"fixed\" (every one to cg_tolerance) or "
+         "\"adaptive\" (Eisenstat and Walker's forcing term: from 0.1 of the residual while Newton is far from the "
+         "solution down to cg_tolerance as it converges; a step converges on its update only after a solve to "
+         "cg_tolerance)",
+         "fixed"},
+        {{"fixed", Forcing::fixed}, {"adaptive", Forcing::adaptive}});
+  else if (s.has("cg_forcing"))
+    s.fail("cg_forcing", "applies to conjugate gradients only: set seepage.linear_solver = \"cg\" or \"lagged\"");
   if (st.linear_solver == LinearSolver::cg)
     st.cg_max_iterations = s.integer<int>({"cg_max_iterations",
                                            "conjugate gradient iterations before the step is cut and retried",

@@ -402,8 +402,14 @@ std::optional<std::string> SolverOf<Dim>::try_step(double h, int& iterations) {
   // The update criterion needs one more iteration to confirm convergence; a
   // residual this small relative to its terms needs none.
   const double residual_tolerance = 1e-2 * settings_.tolerance;
+  // Eisenstat and Walker's forcing term, choice 2 (gamma 0.9, alpha 2), from
+  // 0.1 at a step's first iteration down to cg_tolerance.
+  const bool adaptive = settings_.cg_forcing == Forcing::adaptive && settings_.linear_solver != LinearSolver::direct;
+  const double loosest = std::max(0.1, settings_.cg_tolerance);
+  double forcing = loosest;
   for (iterations = 1; iterations <= settings_.max_iterations; ++iterations) {
     ++timings_.nonlinear_iterations;
+    if (adaptive) set_linear_tolerance(forcing);
     if (auto failure = newton_direction(trial_, a0, h)) return failure;
     if (!delta_.allFinite()) return "the Newton update is not finite";
 
@@ -430,13 +436,24 @@ std::optional<std::string> SolverOf<Dim>::try_step(double h, int& iterations) {
     }
     const double update = alpha * delta_.lpNorm<Eigen::Infinity>();
     trial_.swap(candidate_);
+    const double reduction = trial_norm / norm;
     norm = trial_norm;
     if (!std::isfinite(norm)) return "the residual is not finite";
-    if (update <= settings_.tolerance * trial_.lpNorm<Eigen::Infinity>() ||
+    // A small update from a loose solve says little: the true Newton step may
+    // be the condition number times the forcing term larger. It counts only
+    // from a solve to cg_tolerance.
+    const bool small_update = update <= settings_.tolerance * trial_.lpNorm<Eigen::Infinity>();
+    if ((small_update && (!adaptive || forcing <= settings_.cg_tolerance)) ||
         norm <= residual_tolerance * residual_scale_) {
       // r_ holds the residual of the accepted iterate, fixed rows included.
       accept_step(h, a0, a2);
       return std::nullopt;
+    }
+    if (adaptive) {
+      const double kept = 0.9 * forcing * forcing;  // safeguard: no sudden drop after a slow iteration
+      forcing = 0.9 * reduction * reduction;
+      if (kept > 0.1) forcing = std::max(forcing, kept);
+      forcing = small_update ? settings_.cg_tolerance : std::clamp(forcing, settings_.cg_tolerance, loosest);
     }
   }
   iterations = settings_.max_iterations;
@@ -561,6 +578,14 @@ bool SolverOf<Dim>::lagged_conjugate_gradients() {
 }
 
 template <int Dim>
+void SolverOf<Dim>::set_linear_tolerance(double tolerance) {
+  if (settings_.linear_solver == LinearSolver::cg)
+    cg_.setTolerance(tolerance);
+  else
+    lagged_cg_.setTolerance(tolerance);
+}
+
+template <int Dim>
 std::optional<std::string> SolverOf<Dim>::factorise() {
   ScopedTimer timer(timings_.factorization);
   ++timings_.factorizations;
@@ -593,8 +618,9 @@ std::optional<std::string> SolverOf<Dim>::conjugate_gradients() {
     return fmt::format("conjugate gradients broke down after {} iterations (is the Jacobian positive definite?)",
                        cg_.iterations());
   return fmt::format("conjugate gradients reached a relative residual of {:.2e} in {} iterations "
-                     "(seepage.cg_max_iterations = {}), short of seepage.cg_tolerance = {:.2e}",
-                     cg_.error(), cg_.iterations(), settings_.cg_max_iterations, settings_.cg_tolerance);
+                     "(seepage.cg_max_iterations = {}), short of {:.2e} (seepage.cg_tolerance = {:.2e})",
+                     cg_.error(), cg_.iterations(), settings_.cg_max_iterations, cg_.tolerance(),
+                     settings_.cg_tolerance);
 }
 
 template <int Dim>

@@ -185,6 +185,7 @@ class SolverOf {
   std::vector<Point> cell_flux() const;                 // -k grad u at cell centres [m/s]
   const Balance& balance() const { return balance_; }
   const Timings& timings() const { return timings_; }
+  const Settings& settings() const { return settings_; }
 
   // How CHOLMOD factorises (with Settings::linear_solver direct).
   const Factorisation& factorisation() const { return factorisation_; }
@@ -215,6 +216,8 @@ class SolverOf {
   // delta_ by conjugate gradients preconditioned by factor_ (of an earlier
   // Jacobian); false when they need more than lag_max_iterations.
   bool lagged_conjugate_gradients();
+  // The relative residual conjugate gradients solve the next Newton system to.
+  void set_linear_tolerance(double tolerance);
   void accept_step(double h, double a0, double a2);
 
   MeshOf<Dim> mesh_;

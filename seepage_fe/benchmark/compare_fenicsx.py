@@ -11,8 +11,9 @@ storage integrated at the cell corners (Gauss-Lobatto, degree 1: the lumped stor
 solves it with its NewtonSolver and MUMPS LU, as its users would; it runs as one process
 with `--threads` OpenBLAS threads and as `--threads` MPI processes, and the faster of the
 two is the reference. Ours runs seepage-benchmark with `--threads` threads under each of
-its linear solvers (direct, cg and lagged at seepage.cg_tolerance's default, and lagged at
-`--loose-tolerance`), each a run of `--steps` steps from the state after a first step, the
+its linear solvers (direct, cg and lagged at seepage.cg_tolerance's default, lagged with
+Eisenstat and Walker's forcing term down to that default (seepage.cg_forcing = "adaptive"),
+and lagged at `--loose-tolerance`), each a run of `--steps` steps from the state after a first step, the
 first of them factorising afresh; each row says how far its solution lies from the direct
 one's (max |u - u_direct| / max |u_direct|). Each timed step is a whole Newton solve
 (assemblies, factorisations, solves), divided by its iterations: FEniCSx's best step, our
@@ -109,7 +110,7 @@ def fenicsx(cells, steps, processes, threads):
 
 def ours(build, cells, steps, threads, loose_tolerance):
     """{contender: seepage-benchmark's Newton row} for each of our linear solvers."""
-    runs = ((("direct", "cg", "lagged"), None, ""), (("direct", "lagged"), loose_tolerance, f", cg_tolerance {loose_tolerance:g}"))
+    runs = ((("direct", "cg", "lagged", "lagged-adaptive"), None, ""), (("direct", "lagged"), loose_tolerance, f", cg_tolerance {loose_tolerance:g}"))
     rows = {}
     with tempfile.TemporaryDirectory() as tmp:
         path = os.path.join(tmp, "newton.csv")
@@ -162,7 +163,7 @@ def main(argv=None):
     if not os.access(os.path.join(args.build, "seepage_fe", "seepage-benchmark"), os.X_OK):
         sys.exit(f"compare_fenicsx: no {args.build}/seepage_fe/seepage-benchmark: build first (scripts/build.sh)")
 
-    mine_names = ["ours, direct", "ours, cg", "ours, lagged", f"ours, lagged, cg_tolerance {args.loose_tolerance:g}"]
+    mine_names = ["ours, direct", "ours, cg", "ours, lagged", "ours, lagged-adaptive", f"ours, lagged, cg_tolerance {args.loose_tolerance:g}"]
     fenicsx_names = ["FEniCSx, 1 process", f"FEniCSx, {args.threads} processes"]
     contenders = mine_names + fenicsx_names
     rows = []

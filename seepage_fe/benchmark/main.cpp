@@ -98,10 +98,16 @@ seepage::Timings minus(const seepage::Timings& a, const seepage::Timings& b) {
   return d;
 }
 
-seepage::LinearSolver linear_solver(const std::string& name) {
-  if (name == "cg") return seepage::LinearSolver::cg;
-  if (name == "lagged") return seepage::LinearSolver::lagged;
-  return seepage::LinearSolver::direct;
+// A Newton row's linear solver by name: direct, cg or lagged, the iterative
+// ones with "-adaptive" for Eisenstat and Walker's forcing term.
+seepage::Settings linear_solver(const std::string& name, double cg_tolerance) {
+  seepage::Settings settings;
+  settings.linear_solver = name.starts_with("cg")       ? seepage::LinearSolver::cg
+                           : name.starts_with("lagged") ? seepage::LinearSolver::lagged
+                                                        : seepage::LinearSolver::direct;
+  settings.cg_tolerance = cg_tolerance;
+  if (name.ends_with("-adaptive")) settings.cg_forcing = seepage::Forcing::adaptive;
+  return settings;
 }
 
 template <int Dim>
@@ -109,10 +115,8 @@ void newton_rows(const CaseOf<Dim>& c, const std::vector<std::string>& linear_so
                  int rounds, int steps, std::FILE* csv) {
   std::vector<Contender<Dim>> contenders;
   for (const auto& name : linear_solvers) {
-    seepage::Settings settings;
+    seepage::Settings settings = linear_solver(name, cg_tolerance);
     settings.scheme = seepage::TimeScheme::backward_euler;
-    settings.linear_solver = linear_solver(name);
-    settings.cg_tolerance = cg_tolerance;
     contenders.push_back({name, std::make_unique<seepage::SolverOf<Dim>>(c.mesh, c.model, settings), {}});
     contenders.back().solver->advance(dt);  // first touch of every array
     contenders.back().start = contenders.back().solver->save_state();
@@ -144,19 +148,20 @@ void newton_rows(const CaseOf<Dim>& c, const std::vector<std::string>& linear_so
   for (const auto& k : contenders) {
     const auto& t = k.best;
     const double its = static_cast<double>(t.nonlinear_iterations);
-    const std::string method = k.linear_solver == "cg"       ? "cg/incomplete_cholesky"
-                               : k.linear_solver == "lagged" ? "cg/" + k.solver->factorisation().name()
-                                                             : k.solver->factorisation().name();
+    const auto kind = k.solver->settings().linear_solver;
+    const std::string method = kind == seepage::LinearSolver::cg       ? "cg/incomplete_cholesky"
+                               : kind == seepage::LinearSolver::lagged ? "cg/" + k.solver->factorisation().name()
+                                                                       : k.solver->factorisation().name();
     const long unknowns = static_cast<long>(c.mesh.num_nodes());
     const double cg_iterations = static_cast<double>(t.linear_iterations) / its;
-    std::printf("%9ld %-14s %7.0e %-7s %-24s %7.0f %10.4f %9.4f %9.4f %9.4f %8.1f %8.3f %9.1e\n", unknowns,
+    std::printf("%9ld %-14s %7.0e %-15s %-24s %7.0f %10.4f %9.4f %9.4f %9.4f %8.1f %8.3f %9.1e\n", unknowns,
                 c.mesh_name.c_str(), dt, k.linear_solver.c_str(), method.c_str(), its, k.best_per_iteration,
                 t.factorization / its, t.solve / its, (t.total_step - t.factorization - t.solve) / its,
                 cg_iterations, k.best_per_iteration / direct, k.difference);
     std::fflush(stdout);
     if (csv)
       std::fprintf(csv, "%ld,%s,%g,%d,%s,%s,%g,%.0f,%.6g,%.6g,%.6g,%.6g,%.1f,%.4f,%.3g\n", unknowns, c.mesh_name.c_str(),
-                   dt, steps, k.linear_solver.c_str(), method.c_str(), k.linear_solver == "direct" ? 0.0 : cg_tolerance, its,
+                   dt, steps, k.linear_solver.c_str(), method.c_str(), kind == seepage::LinearSolver::direct ? 0.0 : cg_tolerance, its,
                    k.best_per_iteration, t.factorization / its, t.solve / its,
                    (t.total_step - t.factorization - t.solve) / its, cg_iterations, k.best_per_iteration / direct,
                    k.difference);
@@ -261,8 +266,9 @@ int main(int argc, char** argv) {
   app.add_option("--orderings-csv", orderings_path,
                  "write the factorisations' rows to this CSV (seepage_fe/benchmark/orderings.csv is one, from which "
                  "the solver's choice of mode and ordering is set)");
-  app.add_option("--linear-solvers", linear_solvers, "linear solvers of the Newton rows, the first the reference")
-      ->check(CLI::IsMember({"direct", "cg", "lagged"}))
+  app.add_option("--linear-solvers", linear_solvers, "linear solvers of the Newton rows, the first the reference (-adaptive: the "
+                                                    "conjugate gradients' tolerance by Eisenstat and Walker's forcing term)")
+      ->check(CLI::IsMember({"direct", "cg", "lagged", "cg-adaptive", "lagged-adaptive"}))
       ->capture_default_str();
   app.add_option("--time-step", time_steps, "time steps [s] of the Newton rows, rows for each (the factorisations' "
                                             "rows take the first)")
@@ -300,7 +306,7 @@ int main(int argc, char** argv) {
     std::printf("BLAS: %s; %d rounds, best kept\n", blas::description().c_str(), rounds);
     if (!no_newton) {
       std::printf("\nPer Newton iteration [s] (other: residuals, Jacobian values, line search, bookkeeping; differs: max |u - u_first| / max |u_first| after the round)\n");
-      std::printf("%9s %-14s %7s %-7s %-24s %7s %10s %9s %9s %9s %8s %8s %9s\n", "unknowns", "mesh", "dt", "solver",
+      std::printf("%9s %-14s %7s %-15s %-24s %7s %10s %9s %9s %9s %8s %8s %9s\n", "unknowns", "mesh", "dt", "solver",
                   "method", "Newton", "per it.", "factor", "solve", "other", "cg its", "/ first", "differs");
       for (const auto& c : cases)
         for (double dt : time_steps) newton_rows(c, linear_solvers, dt, cg_tolerance, rounds, steps, csv);
