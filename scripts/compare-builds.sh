@@ -52,13 +52,16 @@ build() {  # build SOURCE_DIR BUILD_DIR
 }
 echo "building $(git -C "$work/base-src" log -1 --format='%h %s' | cut -c1-72) ..."
 build "$work/base-src" "$work/base-build"
+# Each source folder keeps its own build folder (CMake ties a build to its source).
 if [ -n "$other" ]; then
   checkout "$work/other-src" "$other"
   echo "building $(git -C "$work/other-src" log -1 --format='%h %s' | cut -c1-72) ..."
-  build "$work/other-src" "$work/head-build"
+  head_build=$work/other-build
+  build "$work/other-src" "$head_build"
 else
   echo "building this checkout ($(git describe --always --dirty)) ..."
-  build "$PWD" "$work/head-build"
+  head_build=$work/head-build
+  build "$PWD" "$head_build"
 fi
 
 # The program a scene names: [scene] solvers.
@@ -78,7 +81,9 @@ for scene in "${scenes[@]}"; do
   p=$(program "$scene")
   for side in base head; do
     mkdir -p "$work/runs/$side"
-    OMP_NUM_THREADS=1 "$work/$side-build/$p" "$scene" -q -j 1 --overwrite -o "$work/runs/$side/$name" \
+    build_dir=$work/base-build
+    [ $side = head ] && build_dir=$head_build
+    OMP_NUM_THREADS=1 "$build_dir/$p" "$scene" -q -j 1 --overwrite -o "$work/runs/$side/$name" \
       > "$work/runs-$side-$name.log" 2>&1 || { echo "$name: $side run failed: $work/runs-$side-$name.log" >&2; exit 2; }
   done
   /usr/bin/python3 scripts/same-results.py "$work/runs/base/$name" "$work/runs/head/$name" || differ=1
