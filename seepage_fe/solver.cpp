@@ -617,10 +617,14 @@ std::optional<std::string> SolverOf<Dim>::conjugate_gradients() {
   if (!std::isfinite(cg_.error()))
     return fmt::format("conjugate gradients broke down after {} iterations (is the Jacobian positive definite?)",
                        cg_.iterations());
+  const std::string target =
+      settings_.cg_forcing == Forcing::adaptive
+          ? fmt::format("{:.2e} (the adaptive forcing term; seepage.cg_tolerance = {:.2e})", cg_.tolerance(),
+                        settings_.cg_tolerance)
+          : fmt::format("seepage.cg_tolerance = {:.2e}", settings_.cg_tolerance);
   return fmt::format("conjugate gradients reached a relative residual of {:.2e} in {} iterations "
-                     "(seepage.cg_max_iterations = {}), short of {:.2e} (seepage.cg_tolerance = {:.2e})",
-                     cg_.error(), cg_.iterations(), settings_.cg_max_iterations, cg_.tolerance(),
-                     settings_.cg_tolerance);
+                     "(seepage.cg_max_iterations = {}), short of {}",
+                     cg_.error(), cg_.iterations(), settings_.cg_max_iterations, target);
 }
 
 template <int Dim>
