@@ -403,8 +403,10 @@ std::optional<std::string> SolverOf<Dim>::try_step(double h, int& iterations) {
   // residual this small relative to its terms needs none.
   const double residual_tolerance = 1e-2 * settings_.tolerance;
   // Eisenstat and Walker's forcing term, choice 2 (gamma 0.9, alpha 2), from
-  // 0.1 at a step's first iteration down to cg_tolerance.
-  const bool adaptive = settings_.cg_forcing == Forcing::adaptive && settings_.linear_solver != LinearSolver::direct;
+  // 0.1 at a step's first iteration down to cg_tolerance. Not for the linear
+  // law: one solve to cg_tolerance is its whole Newton iteration.
+  const bool adaptive = settings_.cg_forcing == Forcing::adaptive &&
+                        settings_.linear_solver != LinearSolver::direct && law != Law::linear;
   const double loosest = std::max(0.1, settings_.cg_tolerance);
   double forcing = loosest;
   for (iterations = 1; iterations <= settings_.max_iterations; ++iterations) {
@@ -618,7 +620,7 @@ std::optional<std::string> SolverOf<Dim>::conjugate_gradients() {
     return fmt::format("conjugate gradients broke down after {} iterations (is the Jacobian positive definite?)",
                        cg_.iterations());
   const std::string target =
-      settings_.cg_forcing == Forcing::adaptive
+      cg_.tolerance() > settings_.cg_tolerance
           ? fmt::format("{:.2e} (the adaptive forcing term; seepage.cg_tolerance = {:.2e})", cg_.tolerance(),
                         settings_.cg_tolerance)
           : fmt::format("seepage.cg_tolerance = {:.2e}", settings_.cg_tolerance);

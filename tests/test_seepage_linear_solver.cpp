@@ -172,6 +172,19 @@ TEST_CASE("an adaptive forcing term spends fewer conjugate gradient iterations f
     CHECK((adaptive.unknown() - direct.unknown()).lpNorm<Eigen::Infinity>() < 1e-9 * scale);
     CHECK((fixed.unknown() - direct.unknown()).lpNorm<Eigen::Infinity>() < 1e-9 * scale);
   }
+  // Darcy flow is linear: one solve to cg_tolerance per Newton iteration, as
+  // under the fixed forcing.
+  const seepage::Material rock{1e-15 / 1e-3, 1e-9, 1e6};
+  seepage::Settings loose = with_cg();
+  loose.cg_forcing = seepage::Forcing::adaptive;
+  auto fixed = rectangle_solver(seepage::Law::linear, {10, 1}, {40, 4}, rock, {fixed_pressure("left", 1e5)}, with_cg());
+  auto adaptive = rectangle_solver(seepage::Law::linear, {10, 1}, {40, 4}, rock, {fixed_pressure("left", 1e5)}, loose);
+  for (int k = 0; k < 5; ++k) {
+    fixed.advance(0.5);
+    adaptive.advance(0.5);
+  }
+  CHECK(adaptive.timings().nonlinear_iterations == fixed.timings().nonlinear_iterations);
+  CHECK(adaptive.timings().linear_iterations == fixed.timings().linear_iterations);
 }
 
 TEST_CASE("conjugate gradients solve the linear law as CHOLMOD does, reusing their preconditioner",
