@@ -63,6 +63,11 @@ CASES = [
          ['output.checkpoint_interval="0.01 s"'], 1,
          [(signal.SIGKILL, "run"), (signal.SIGTERM, "run")], ["seepage.xdmf", "particles.xdmf"],
          ["coupling.csv", "mpm_history.csv", "seepage_history.csv"]),
+    # The same in 3D: hexahedra, six stress components, the 3D solid's state.
+    Case("Terzaghi 3D, implicit IQN-ILS", "coupler/outburst", "terzaghi_3d/terzaghi_3d.toml",
+         ['output.checkpoint_interval="0.01 s"'], 1,
+         [(signal.SIGKILL, "run")], ["seepage.xdmf", "particles.xdmf"],
+         ["coupling.csv", "mpm_history.csv", "seepage_history.csv", "tracers.csv"]),
     # Damage, open cells and the gas force of the outburst, implicit ...
     Case("gas face, implicit IQN-ILS", "coupler/outburst", "gas_face/gas_face.toml",
          ['output.checkpoint_interval="1 ms"'], 1,
