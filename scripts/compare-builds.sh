@@ -17,6 +17,16 @@
 #   rebuilt incrementally.
 # Exit 0 when every scene's results are equal, 1 when one differs.
 set -euo pipefail
+# Scene paths as given, from the caller's folder.
+args=()
+for a in "$@"; do
+  case "$a" in
+    *.toml) [ -f "$a" ] || { echo "$a: no such scene file" >&2; exit 2; }
+            args+=("$(realpath "$a")") ;;
+    *) args+=("$a") ;;
+  esac
+done
+set -- "${args[@]+"${args[@]}"}"
 cd "$(dirname "$0")/.."
 commit() { git rev-parse --verify --quiet "$1^{commit}" || { echo "$1: not a commit" >&2; exit 2; }; }
 other=
@@ -25,7 +35,7 @@ if [ "${1:-}" = --other ]; then
   other=$(commit "$2")
   shift 2
 fi
-[ $# -ge 1 ] || { sed -n '2,19p' "$0"; exit 2; }
+[ $# -ge 1 ] || { sed -n '2,18p' "$0"; exit 2; }
 base=$(commit "$1")
 shift
 scenes=("$@")
