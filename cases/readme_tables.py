@@ -460,14 +460,15 @@ def outburst_cost(rows):
 @block("mpm benchmark", "mpm_solid/benchmark/mpm-benchmark.csv")
 def mpm_benchmark(rows):
     materials = ["elastic", "drucker_prager", "elastic_damage"]
-    lines = ["| particles | shape | " + " | ".join(materials) + " | bytes per particle (own + grid) |",
+    lines = ["| particles | shape | " + " | ".join(f"{m}: 1 / 2 threads (speed-up)" for m in materials) +
+             " | bytes per particle (own + grid) |",
              "|---|---|---|---|---|---|"]
     cases = {}
     for r in rows:
         cases.setdefault((int(r["particles"]), r["shape"]), {})[r["material"]] = r
     for (n, shape), by_material in cases.items():
-        speeds = [f"{sci(float(by_material[m]['one_thread']), 2)} / {sci(float(by_material[m]['two_threads']), 2)}"
-                  for m in materials]
+        speeds = [f"{sci(float(by_material[m]['one_thread']), 2)} / {sci(float(by_material[m]['two_threads']), 2)} "
+                  f"({float(by_material[m]['speed_up']):.2f}x)" for m in materials]
         memory = [f"{int(float(by_material[m]['bytes_per_particle']))} + "
                   f"{int(float(by_material[m]['grid_bytes_per_particle']))}" for m in materials]
         lines.append(f"| {sci(n, 0)} | {shape} | " + " | ".join(speeds) + " | " + ", ".join(memory) + " |")
