@@ -85,17 +85,32 @@ constexpr bool lean_build = false;
 // and the loop stalled reloading them whole from halves just stored (a store
 // is not forwarded to a wider load): 6 % of a B-spline step.
 
-// L = grad v at a particle, from the grid's velocities, into l.
-template <int Dim, class Shape>
-[[gnu::always_inline]] inline void velocity_gradient_at(const std::vector<Vec<Dim>>& velocity,
-                                                        const Stencil<Dim, Shape>& s, Mat<Dim>& l) {
-  std::array<Vec<Dim>, Dim> along;  // d v / d x_d
-  along.fill(Vec<Dim>::Zero());
-  for (int k = 0; k < s.count; ++k) {
-    const Vec<Dim>& v = velocity[s.node[k]];
-    for (int d = 0; d < Dim; ++d) along[d] += v * s.gradient[d][k];
+// L = grad v from the grid's velocities at the particles of a chunk's
+// lanes, into gradient[particle(lane)].
+template <int Dim, class Shape, int Width, class Index>
+[[gnu::always_inline]] inline void velocity_gradients(const std::vector<Vec<Dim>>& velocity,
+                                                      const StencilLanes<Dim, Shape, Width>& s, int lanes,
+                                                      Index particle, std::vector<Mat<Dim>>& gradient) {
+  const double* nodal = velocity.data()->data();
+  alignas(64) double l[Dim][Dim][Width] = {};  // d v_b / d x_d
+  s.for_each_node([&](int k, const std::array<int, Dim>& a) {
+    const std::ptrdiff_t offset = s.offset[k];
+#pragma omp simd
+    for (int lane = 0; lane < lanes; ++lane) {
+      const double* v = nodal + Dim * (s.first[lane] + offset);
+#pragma GCC unroll 3
+      for (int d = 0; d < Dim; ++d) {
+        const double g = s.gradient(d, a, lane);
+#pragma GCC unroll 3
+        for (int b = 0; b < Dim; ++b) l[b][d][lane] += v[b] * g;
+      }
+    }
+  });
+  for (int lane = 0; lane < lanes; ++lane) {
+    Mat<Dim>& out = gradient[particle(lane)];
+    for (int b = 0; b < Dim; ++b)
+      for (int d = 0; d < Dim; ++d) out(b, d) = l[b][d][lane];
   }
-  for (int d = 0; d < Dim; ++d) l.col(d) = along[d];
 }
 
 // What a step's nodal forces take from the particles, decided once per pass:
@@ -115,27 +130,30 @@ ForceTerms<Dim> force_terms(const Particles<Dim>& p, const Settings<Dim>& settin
           !lean_build && (loads || g.squaredNorm() > 0)};
 }
 
-// Adds particle i's internal and body forces to the nodes of its stencil.
-template <int Dim, class Shape>
+// Adds particle i's internal and body forces to the nodes of its stencil,
+// lane `lane` of a chunk's.
+template <int Dim, class Shape, int Width>
 [[gnu::always_inline]] inline void add_forces(const Particles<Dim>& p, const ForceTerms<Dim>& t, int i,
-                                              const Stencil<Dim, Shape>& s, std::vector<Vec<Dim>>& f) {
+                                              const StencilLanes<Dim, Shape, Width>& s, int lane,
+                                              std::vector<Vec<Dim>>& f) {
   Mat<Dim> vs = p.volume[i] * p.stress[i];
   if (t.pore) vs.diagonal().array() -= p.volume[i] * t.pore[i];
+  Vec<Dim>* at = f.data() + s.first[lane];
   if (!t.body_forces) {
-    for (int k = 0; k < s.count; ++k) {
-      Vec<Dim> internal = vs.col(0) * s.gradient[0][k];
-      for (int d = 1; d < Dim; ++d) internal += vs.col(d) * s.gradient[d][k];
-      f[s.node[k]] -= internal;
-    }
+    s.for_each_node([&](int k, const std::array<int, Dim>& a) {
+      Vec<Dim> internal = vs.col(0) * s.gradient(0, a, lane);
+      for (int d = 1; d < Dim; ++d) internal += vs.col(d) * s.gradient(d, a, lane);
+      at[s.offset[k]] -= internal;
+    });
     return;
   }
   const Vec<Dim> body = t.loads ? Vec<Dim>(p.mass[i] * t.gravity + p.external_force[i] + p.surface_force[i])
                                 : Vec<Dim>(p.mass[i] * t.gravity);
-  for (int k = 0; k < s.count; ++k) {
-    Vec<Dim> total = s.weight[k] * body;
-    for (int d = 0; d < Dim; ++d) total -= vs.col(d) * s.gradient[d][k];
-    f[s.node[k]] += total;
-  }
+  s.for_each_node([&](int k, const std::array<int, Dim>& a) {
+    Vec<Dim> total = s.weight(a, lane) * body;
+    for (int d = 0; d < Dim; ++d) total -= vs.col(d) * s.gradient(d, a, lane);
+    at[s.offset[k]] += total;
+  });
 }
 
 void refuse_in_lean_build(bool named, const char* what) {
@@ -353,27 +371,52 @@ void Solver<Dim>::scatter_mass_momentum() {
     std::uint8_t* reached = active_.marks(omp_get_thread_num());
     const auto strides = active_.strides();
     const Lattice<Dim> lattice(grid_);
-    Stencil<Dim, Shape> s;
+    if constexpr (!Apic) {
+      using Lanes = StencilLanes<Dim, Shape>;
+      Lanes s(lattice);
+      const int chunks = (n + Lanes::width - 1) / Lanes::width;
 #pragma omp for schedule(static)
-    for (int i = 0; i < n; ++i) {
-      // Particles leave the grid at the end of a step; one beyond its ghost
-      // nodes here came from outside (a solver built with it there).
-      if (!s.template compute<Apic>(lattice, p.x[i], p.half_width[i])) {
-        ++outside;
-        continue;
+      for (int c = 0; c < chunks; ++c) {
+        const int start = c * Lanes::width, lanes = std::min(Lanes::width, n - start);
+        s.compute(lattice, p.x.data(), p.half_width.data(), [start](int lane) { return start + lane; }, lanes);
+        for (int lane = 0; lane < lanes; ++lane) {
+          // Particles leave the grid at the end of a step; one beyond its ghost
+          // nodes here came from outside (a solver built with it there).
+          if (!s.inside(lattice, lane)) {
+            ++outside;
+            continue;
+          }
+          ActiveBlocks<Dim>::template set_reached<Shape::support>(reached, strides, s.lowest(lane));
+          const int i = start + lane;
+          const double mass = p.mass[i];
+          const Vec<Dim> v = p.v[i];
+          double* m_at = m + s.first[lane];
+          Vec<Dim>* mv_at = mv + s.first[lane];
+          s.for_each_node([&](int k, const std::array<int, Dim>& a) {
+            const double wm = s.weight(a, lane) * mass;
+            m_at[s.offset[k]] += wm;
+            mv_at[s.offset[k]] += wm * v;
+          });
+        }
       }
-      ActiveBlocks<Dim>::template set_reached<Shape::support>(reached, strides, s.base);
-      // Read once: the compiler cannot tell the nodal sums from the
-      // particle's fields, and would load these again after every store.
-      const double mass = p.mass[i];
-      const Vec<Dim> v = p.v[i];
-      for (int k = 0; k < s.count; ++k) {
-        const double wm = s.weight[k] * mass;
-        m[s.node[k]] += wm;
-        if constexpr (Apic)
+    } else {
+      Stencil<Dim, Shape> s;
+#pragma omp for schedule(static)
+      for (int i = 0; i < n; ++i) {
+        if (!s.template compute<Apic>(lattice, p.x[i], p.half_width[i])) {
+          ++outside;
+          continue;
+        }
+        ActiveBlocks<Dim>::template set_reached<Shape::support>(reached, strides, s.base);
+        // Read once: the compiler cannot tell the nodal sums from the
+        // particle's fields, and would load these again after every store.
+        const double mass = p.mass[i];
+        const Vec<Dim> v = p.v[i];
+        for (int k = 0; k < s.count; ++k) {
+          const double wm = s.weight[k] * mass;
+          m[s.node[k]] += wm;
           mv[s.node[k]] += wm * (v + p.affine[i] * s.offset[k]);
-        else
-          mv[s.node[k]] += wm * v;
+        }
       }
     }
   }
@@ -447,14 +490,18 @@ template <class Shape>
 void Solver<Dim>::gather_velocity_gradient() {
   auto& p = particles_;
   const int n = static_cast<int>(p.size());
+  using Lanes = StencilLanes<Dim, Shape>;
+  const int chunks = (n + Lanes::width - 1) / Lanes::width;
 #pragma omp parallel
   {
     const Lattice<Dim> lattice(grid_);
-    Stencil<Dim, Shape> s;
+    Lanes s(lattice);
 #pragma omp for schedule(static)
-    for (int i = 0; i < n; ++i) {
-      s.compute(lattice, p.x[i], p.half_width[i]);
-      velocity_gradient_at(velocity_, s, p.velocity_gradient[i]);
+    for (int c = 0; c < chunks; ++c) {
+      const int start = c * Lanes::width, lanes = std::min(Lanes::width, n - start);
+      const auto particle = [start](int lane) { return start + lane; };
+      s.compute(lattice, p.x.data(), p.half_width.data(), particle, lanes);
+      velocity_gradients(velocity_, s, lanes, particle, p.velocity_gradient);
     }
   }
 }
@@ -518,15 +565,18 @@ void Solver<Dim>::scatter_forces() {
   const ForceTerms<Dim> terms = force_terms(p, settings_);
   Scatter<Vec<Dim>> forces{thread_vector_, force_, active_.runs()};
   forces.clear();
+  using Lanes = StencilLanes<Dim, Shape>;
+  const int chunks = (n + Lanes::width - 1) / Lanes::width;
 #pragma omp parallel num_threads(threads_)
   {
     auto& f = forces.buffer(omp_get_thread_num());
     const Lattice<Dim> lattice(grid_);
-    Stencil<Dim, Shape> s;
+    Lanes s(lattice);
 #pragma omp for schedule(static)
-    for (int i = 0; i < n; ++i) {
-      s.compute(lattice, p.x[i], p.half_width[i]);
-      add_forces(p, terms, i, s, f);
+    for (int c = 0; c < chunks; ++c) {
+      const int start = c * Lanes::width, lanes = std::min(Lanes::width, n - start);
+      s.compute(lattice, p.x.data(), p.half_width.data(), [start](int lane) { return start + lane; }, lanes);
+      for (int lane = 0; lane < lanes; ++lane) add_forces(p, terms, start + lane, s, lane, f);
     }
   }
   forces.gather();
@@ -537,9 +587,10 @@ void Solver<Dim>::scatter_forces() {
 // chunk of each material's particles at a time: the chunk's stencils and
 // fields are still in cache when its forces are scattered, where three
 // passes would compute the stencils twice and stream the fields three times.
-// It measures faster under quadratic B-splines and slower under linear
-// shapes, whose stencils cost less to compute than to keep, so those stay on
-// the three passes (mpm_solid/benchmark/compare-c88bc1c-fused.csv).
+// It measures faster under quadratic B-splines and no faster under linear
+// shapes, whose stencils cost little to compute again, so those stay on the
+// three passes (mpm_solid/benchmark/compare-c88bc1c-fused.csv; measured
+// again with StencilLanes).
 template <int Dim>
 template <class Shape>
 void Solver<Dim>::update_and_scatter(double dt) {
@@ -552,7 +603,7 @@ void Solver<Dim>::update_and_scatter(double dt) {
   {
     auto& f = forces.buffer(omp_get_thread_num());
     const Lattice<Dim> lattice(grid_);
-    std::vector<Stencil<Dim, Shape>> stencils(chunk_size);
+    StencilLanes<Dim, Shape, chunk_size> s(lattice);
     for (std::size_t m = 0; m < materials_.size(); ++m) {
       const std::span<const int> members(members_[m]);
       const int n = static_cast<int>(members.size()), chunks = (n + chunk_size - 1) / chunk_size;
@@ -561,14 +612,14 @@ void Solver<Dim>::update_and_scatter(double dt) {
 #pragma omp for schedule(static) nowait
       for (int c = 0; c < chunks; ++c) {
         const auto chunk = members.subspan(c * chunk_size, std::min(chunk_size, n - c * chunk_size));
-        for (std::size_t k = 0; k < chunk.size(); ++k) {
-          stencils[k].compute(lattice, p.x[chunk[k]], p.half_width[chunk[k]]);
-          velocity_gradient_at(velocity_, stencils[k], p.velocity_gradient[chunk[k]]);
-        }
+        const int lanes = static_cast<int>(chunk.size());
+        const auto particle = [&chunk](int lane) { return chunk[static_cast<std::size_t>(lane)]; };
+        s.compute(lattice, p.x.data(), p.half_width.data(), particle, lanes);
+        velocity_gradients(velocity_, s, lanes, particle, p.velocity_gradient);
         const Dissipation d = materials_[m]->update_chunk(p, chunk, dt);
         plastic += d.plastic;
         damage += d.damage;
-        for (std::size_t k = 0; k < chunk.size(); ++k) add_forces(p, terms, chunk[k], stencils[k], f);
+        for (int lane = 0; lane < lanes; ++lane) add_forces(p, terms, chunk[lane], s, lane, f);
       }
     }
   }
@@ -786,61 +837,112 @@ void Solver<Dim>::gather_motion(double dt) {
   Census census;
   double lost = 0, work = 0, gained = 0;
   const bool loads = !lean_build && !p.external_force.empty();
+  // Particle i's new velocity (and, under APIC, its B matrix from b and d)
+  // and position from what its stencil gathered, and the energy books: the
+  // calling thread's census and sums, passed in, since a lambda made out here
+  // would capture the shared ones rather than the thread's reduction copies.
+  const auto finish = [&](int i, const Vec<Dim>& v_pic, const Vec<Dim>& dv, double spread, double affine,
+                          const Mat<Dim>& b, const Vec<Dim>& d, Census& census, double& lost, double& work,
+                          double& gained) {
+    // Pure FLIP hands each particle the grid's change, interpolated: its
+    // kinetic energy gains m (v . dv + |dv|^2 / 2), short of the grid's
+    // share m ((v + affine) . dv + sum w |dv_i|^2 / 2) by the increment's
+    // spread over the stencil (and under APIC the affine term). It keeps
+    // what the grid cannot hold (sub-cell velocity differences); the PIC
+    // share, and APIC, replace that with the grid's field. All of it is
+    // what the transfer takes.
+    const Vec<Dim> v_flip = p.v[i] + dv;
+    gained += 0.5 * p.mass[i] * spread;
+    lost += 0.5 * p.mass[i] * (spread - dv.squaredNorm()) + p.mass[i] * affine;
+    if constexpr (!Move) displacement_[i] = dt * v_pic;
+    if constexpr (Apic) {
+      // D is diagonal for tensor-product shapes that reproduce linear fields;
+      // a particle on a linear-shape node has D = 0 along that axis (and B too).
+      p.v[i] = v_pic;
+      for (int c = 0; c < Dim; ++c)
+        p.affine[i].col(c) = d[c] > 1e-12 * grid_.h * grid_.h ? Vec<Dim>(b.col(c) / d[c]) : Vec<Dim>::Zero();
+    } else {
+      p.v[i] = flip * v_flip + (1 - flip) * v_pic;
+    }
+    lost += 0.5 * p.mass[i] * (v_flip.squaredNorm() - p.v[i].squaredNorm());
+    // The external force works along the way the particle went, at the
+    // grid's velocity halfway through the step (the grid's kinetic energy
+    // changes by f (v + v_new) dt / 2), not its own FLIP-blended one.
+    if (loads) work += (p.external_force[i] + p.surface_force[i]).dot(dt * (v_pic - 0.5 * dv));
+    if constexpr (Move) {
+      const Vec<Dim> moved = dt * v_pic;
+      p.x[i] += moved;
+      count(i, dt, census);
+    }
+  };
+  if constexpr (Apic) {
 #pragma omp parallel reduction(merge : census) reduction(+ : lost, work, gained)
-  {
-    const Lattice<Dim> lattice(grid_);
-    Stencil<Dim, Shape> s;
+    {
+      const Lattice<Dim> lattice(grid_);
+      Stencil<Dim, Shape> s;
 #pragma omp for schedule(static)
-    for (int i = 0; i < n; ++i) {
-      s.template compute<Apic>(lattice, p.x[i], p.half_width[i]);
-      Vec<Dim> v_pic = Vec<Dim>::Zero(), dv = Vec<Dim>::Zero();
-      Mat<Dim> b = Mat<Dim>::Zero();
-      Vec<Dim> d = Vec<Dim>::Zero();  // diagonal of D = sum w (x_i - x_p)(x_i - x_p)^T
-      double spread = 0;          // sum w |dv_i|^2
-      double affine = 0;          // sum w (C (x_i - x_p)) . dv_i
-      for (int k = 0; k < s.count; ++k) {
-        const auto node = s.node[k];
-        const Vec<Dim> change = velocity_new_[node] - velocity_[node];
-        v_pic += s.weight[k] * velocity_new_[node];
-        dv += s.weight[k] * change;
-        spread += s.weight[k] * change.squaredNorm();
-        if constexpr (Apic) {
+      for (int i = 0; i < n; ++i) {
+        s.template compute<true>(lattice, p.x[i], p.half_width[i]);
+        Vec<Dim> v_pic = Vec<Dim>::Zero(), dv = Vec<Dim>::Zero();
+        Mat<Dim> b = Mat<Dim>::Zero();
+        Vec<Dim> d = Vec<Dim>::Zero();  // diagonal of D = sum w (x_i - x_p)(x_i - x_p)^T
+        double spread = 0;              // sum w |dv_i|^2
+        double affine = 0;              // sum w (C (x_i - x_p)) . dv_i
+        for (int k = 0; k < s.count; ++k) {
+          const auto node = s.node[k];
+          const Vec<Dim> change = velocity_new_[node] - velocity_[node];
+          v_pic += s.weight[k] * velocity_new_[node];
+          dv += s.weight[k] * change;
+          spread += s.weight[k] * change.squaredNorm();
           b += s.weight[k] * velocity_new_[node] * s.offset[k].transpose();
           d += s.weight[k] * s.offset[k].cwiseProduct(s.offset[k]);
           // The affine share of the momentum this particle mapped, which
           // its own velocity does not carry, worked by the update.
           affine += s.weight[k] * (p.affine[i] * s.offset[k]).dot(change);
         }
+        finish(i, v_pic, dv, spread, affine, b, d, census, lost, work, gained);
       }
-      // Pure FLIP hands each particle the grid's change, interpolated: its
-      // kinetic energy gains m (v . dv + |dv|^2 / 2), short of the grid's
-      // share m ((v + affine) . dv + sum w |dv_i|^2 / 2) by the increment's
-      // spread over the stencil (and under APIC the affine term). It keeps
-      // what the grid cannot hold (sub-cell velocity differences); the PIC
-      // share, and APIC, replace that with the grid's field. All of it is
-      // what the transfer takes.
-      const Vec<Dim> v_flip = p.v[i] + dv;
-      gained += 0.5 * p.mass[i] * spread;
-      lost += 0.5 * p.mass[i] * (spread - dv.squaredNorm()) + p.mass[i] * affine;
-      if constexpr (!Move) displacement_[i] = dt * v_pic;
-      if constexpr (Apic) {
-        // D is diagonal for tensor-product shapes that reproduce linear fields;
-        // a particle on a linear-shape node has D = 0 along that axis (and B too).
-        p.v[i] = v_pic;
-        for (int c = 0; c < Dim; ++c)
-          p.affine[i].col(c) = d[c] > 1e-12 * grid_.h * grid_.h ? Vec<Dim>(b.col(c) / d[c]) : Vec<Dim>::Zero();
-      } else {
-        p.v[i] = flip * v_flip + (1 - flip) * v_pic;
-      }
-      lost += 0.5 * p.mass[i] * (v_flip.squaredNorm() - p.v[i].squaredNorm());
-      // The external force works along the way the particle went, at the
-      // grid's velocity halfway through the step (the grid's kinetic energy
-      // changes by f (v + v_new) dt / 2), not its own FLIP-blended one.
-      if (loads) work += (p.external_force[i] + p.surface_force[i]).dot(dt * (v_pic - 0.5 * dv));
-      if constexpr (Move) {
-        const Vec<Dim> moved = dt * v_pic;
-        p.x[i] += moved;
-        count(i, dt, census);
+    }
+  } else {
+    using Lanes = StencilLanes<Dim, Shape>;
+    const int chunks = (n + Lanes::width - 1) / Lanes::width;
+    const double *now = velocity_.data()->data(), *next = velocity_new_.data()->data();
+#pragma omp parallel reduction(merge : census) reduction(+ : lost, work, gained)
+    {
+      const Lattice<Dim> lattice(grid_);
+      Lanes s(lattice);
+      const Mat<Dim> b = Mat<Dim>::Zero();
+      const Vec<Dim> d = Vec<Dim>::Zero();
+#pragma omp for schedule(static)
+      for (int c = 0; c < chunks; ++c) {
+        const int start = c * Lanes::width, lanes = std::min(Lanes::width, n - start);
+        s.compute(lattice, p.x.data(), p.half_width.data(), [start](int lane) { return start + lane; }, lanes);
+        alignas(64) double v_pic[Dim][Lanes::width] = {}, dv[Dim][Lanes::width] = {}, spread[Lanes::width] = {};
+        Lanes::for_each_node([&](int k, const std::array<int, Dim>& a) {
+          const std::ptrdiff_t offset = s.offset[k];
+#pragma omp simd
+          for (int lane = 0; lane < lanes; ++lane) {
+            const double weight = s.weight(a, lane);
+            const double *v = now + Dim * (s.first[lane] + offset), *v_new = next + Dim * (s.first[lane] + offset);
+            double squared = 0;
+#pragma GCC unroll 3
+            for (int e = 0; e < Dim; ++e) {
+              const double change = v_new[e] - v[e];
+              v_pic[e][lane] += weight * v_new[e];
+              dv[e][lane] += weight * change;
+              squared += change * change;
+            }
+            spread[lane] += weight * squared;
+          }
+        });
+        for (int lane = 0; lane < lanes; ++lane) {
+          Vec<Dim> pic, change;
+          for (int e = 0; e < Dim; ++e) {
+            pic[e] = v_pic[e][lane];
+            change[e] = dv[e][lane];
+          }
+          finish(start + lane, pic, change, spread[lane], 0.0, b, d, census, lost, work, gained);
+        }
       }
     }
   }

@@ -3,6 +3,8 @@
 // the tensor product of a 1D shape policy over Dim directions.
 
 #include <array>
+#include <cstddef>
+#include <cstdint>
 
 #include "mpm_solid/grid.hpp"
 
@@ -75,6 +77,103 @@ struct Stencil {
           }
     }
     return true;
+  }
+};
+
+// The stencils of a chunk of up to Width particles, one lane per particle:
+// each direction's 1D weights, from which a node's weight and gradient are
+// formed where a pass uses them, with Stencil::compute's products in its
+// order (either gives the same bits). Nothing per node is stored and read
+// back, and the gathers' node loops run over the lanes, for the compiler to
+// vectorise (mpm_solid/README.md has what it gained).
+template <int Dim, class Shape, int Width = 16>
+struct StencilLanes {
+  static constexpr int support = Shape::support;
+  static constexpr int count = Stencil<Dim, Shape>::count;
+  static constexpr int width = Width;
+
+  std::array<std::ptrdiff_t, count> offset;  // of node k from the lowest node, in flat indices
+  double inv_h;
+  alignas(64) std::int64_t first[Width];     // flat index of each lane's lowest node
+  alignas(64) int base[Dim][Width];          // grid coordinates of each lane's lowest node
+  alignas(64) double w[Dim][support][Width];
+  alignas(64) double dw[Dim][support][Width];  // d w / d xi (per cell)
+
+  explicit StencilLanes(const Lattice<Dim>& g) : inv_h(g.inv_h) {
+    const std::ptrdiff_t row = g.nodes_along[0], plane = Dim == 3 ? row * g.nodes_along[1] : 0;
+    for_each_node([&](int k, const std::array<int, Dim>& a) {
+      offset[k] = a[0] + a[1] * row + (Dim == 3 ? a[Dim - 1] * plane : 0);
+    });
+  }
+
+  // f(k, a) over the stencil's nodes in Stencil's order, a the node's place
+  // along each direction.
+  template <class F>
+  static void for_each_node(F&& f) {
+    int k = 0;
+    if constexpr (Dim == 2) {
+      for (int j = 0; j < support; ++j)
+        for (int i = 0; i < support; ++i) f(k++, std::array<int, Dim>{i, j});
+    } else {
+      for (int l = 0; l < support; ++l)
+        for (int j = 0; j < support; ++j)
+          for (int i = 0; i < support; ++i) f(k++, std::array<int, Dim>{i, j, l});
+    }
+  }
+
+  // Lanes 0 .. lanes-1 from particles particle(0), particle(1), ... of the
+  // positions x and half-widths (in cells); inside() says whether each
+  // lane's support lies in the ghost-padded grid.
+  template <class Index>
+  void compute(const Lattice<Dim>& g, const Vec<Dim>* x, const double* half_width, Index particle, int lanes) {
+#pragma omp simd
+    for (int lane = 0; lane < lanes; ++lane) {
+      const auto i = particle(lane);
+      std::int64_t flat = 0;
+#pragma GCC unroll 3
+      for (int d = Dim - 1; d >= 0; --d) {
+        const double xi = (x[i][d] - g.lower[d]) * inv_h + Grid<Dim>::ghost;
+        double wd[support], dwd[support];
+        const int base = Shape::eval(xi, half_width[i], wd, dwd);
+#pragma GCC unroll 3
+        for (int a = 0; a < support; ++a) {
+          w[d][a][lane] = wd[a];
+          dw[d][a][lane] = dwd[a];
+        }
+        flat = flat * g.nodes_along[d] + base;
+        this->base[d][lane] = base;
+      }
+      first[lane] = flat;
+    }
+  }
+
+  // Whether every node of the lane's support lies inside the ghost-padded
+  // grid (else `first` and `offset` point outside the nodal arrays).
+  bool inside(const Lattice<Dim>& g, int lane) const {
+    bool in = true;
+    for (int d = 0; d < Dim; ++d) in = in && base[d][lane] >= 0 && base[d][lane] + support <= g.nodes_along[d];
+    return in;
+  }
+  std::array<int, Dim> lowest(int lane) const {
+    std::array<int, Dim> b;
+    for (int d = 0; d < Dim; ++d) b[d] = base[d][lane];
+    return b;
+  }
+
+  double weight(const std::array<int, Dim>& a, int lane) const {
+    if constexpr (Dim == 2)
+      return w[0][a[0]][lane] * w[1][a[1]][lane];
+    else
+      return w[0][a[0]][lane] * w[1][a[1]][lane] * w[2][a[2]][lane];
+  }
+  // d N / d x_d [1/m]
+  double gradient(int d, const std::array<int, Dim>& a, int lane) const {
+    if constexpr (Dim == 2)
+      return d == 0 ? dw[0][a[0]][lane] * w[1][a[1]][lane] * inv_h : w[0][a[0]][lane] * dw[1][a[1]][lane] * inv_h;
+    else
+      return d == 0   ? dw[0][a[0]][lane] * w[1][a[1]][lane] * w[2][a[2]][lane] * inv_h
+             : d == 1 ? w[0][a[0]][lane] * dw[1][a[1]][lane] * w[2][a[2]][lane] * inv_h
+                      : w[0][a[0]][lane] * w[1][a[1]][lane] * dw[2][a[2]][lane] * inv_h;
   }
 };
 
