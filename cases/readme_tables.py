@@ -457,6 +457,9 @@ def outburst_cost(rows):
     return lines
 
 
+block("outburst cost after 3d", "cases/outburst/benchmark/outburst-benchmark-after-3d.csv")(outburst_cost)
+
+
 @block("mpm benchmark", "mpm_solid/benchmark/mpm-benchmark.csv")
 def mpm_benchmark(rows):
     materials = ["elastic", "drucker_prager", "elastic_damage"]
