@@ -1,0 +1,79 @@
+// A chunk's stencils (StencilLanes, what the particle passes use) against a
+// stencil per particle (Stencil, what APIC and the dilatation remedy use):
+// the same nodes, weights and gradients to the bit, for every shape in 2D
+// and 3D, and the same verdict on a support that leaves the ghost-padded grid.
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cstddef>
+#include <random>
+#include <vector>
+
+#include "mpm_solid/shape.hpp"
+#include "mpm_solid/stencil.hpp"
+
+using namespace outburst::mpm;
+
+namespace {
+
+template <int Dim, class Shape>
+void lanes_agree_with_particles() {
+  Grid<Dim> g;
+  g.h = 0.3;
+  g.lower = Vec<Dim>::Constant(-1.0);
+  for (int d = 0; d < Dim; ++d) g.cells[d] = 7 - d;  // a different node count along each axis
+  for (int d = 0; d < Dim; ++d) g.upper[d] = g.lower[d] + g.cells[d] * g.h;
+  // Positions up to 3 cells beyond the domain: some supports leave the 2
+  // ghost rows.
+  std::mt19937 rng(10 * Dim + Shape::support);
+  std::vector<Vec<Dim>> x(203);
+  std::vector<double> half_width(x.size());
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    for (int d = 0; d < Dim; ++d)
+      x[i][d] = std::uniform_real_distribution<double>(g.lower[d] - 3 * g.h, g.upper[d] + 3 * g.h)(rng);
+    half_width[i] = std::uniform_real_distribution<double>(0.1, 0.45)(rng);  // GIMP's, in cells
+  }
+  const Lattice<Dim> lattice(g);
+  using Lanes = StencilLanes<Dim, Shape, 16>;
+  Lanes lanes(lattice);
+  const int n = static_cast<int>(x.size());
+  int inside = 0, outside = 0, differ = 0;
+  for (int start = 0; start < n; start += Lanes::width) {
+    const int count = std::min(Lanes::width, n - start);
+    lanes.compute(lattice, x.data(), half_width.data(), [start](int lane) { return start + lane; }, count);
+    for (int lane = 0; lane < count; ++lane) {
+      const int i = start + lane;
+      Stencil<Dim, Shape> one;
+      const bool in = one.compute(lattice, x[i], half_width[i]);
+      REQUIRE(lanes.inside(lattice, lane) == in);
+      if (!in) {
+        ++outside;
+        continue;
+      }
+      ++inside;
+      REQUIRE(lanes.lowest(lane) == one.base);
+      Lanes::for_each_node([&](int k, const std::array<int, Dim>& a) {
+        differ += lanes.first[lane] + lanes.offset[k] != static_cast<std::ptrdiff_t>(one.node[k]);
+        differ += lanes.weight(a, lane) != one.weight[k];
+        for (int d = 0; d < Dim; ++d) differ += lanes.gradient(d, a, lane) != one.gradient[d][k];
+      });
+    }
+  }
+  INFO(Shape::name << " in " << Dim << "D: " << inside << " supports inside, " << outside << " leaving");
+  CHECK(inside > 50);
+  CHECK(outside > 10);
+  CHECK(differ == 0);
+}
+
+}  // namespace
+
+TEST_CASE("a chunk's stencils give each particle's nodes, weights and gradients to the bit, and the same verdict "
+          "on supports that leave the grid",
+          "[mpm][stencil]") {
+  lanes_agree_with_particles<2, Linear>();
+  lanes_agree_with_particles<2, Gimp>();
+  lanes_agree_with_particles<2, Bspline>();
+  lanes_agree_with_particles<3, Linear>();
+  lanes_agree_with_particles<3, Gimp>();
+  lanes_agree_with_particles<3, Bspline>();
+}
