@@ -85,7 +85,7 @@ struct Stencil {
 // formed where a pass uses them, with Stencil::compute's products in its
 // order (either gives the same bits). Nothing per node is stored and read
 // back, and the gathers' node loops run over the lanes, for the compiler to
-// vectorise (mpm_solid/README.md has what it gained).
+// vectorise (README.md, The MPM solver, has what it gained).
 template <int Dim, class Shape, int Width = 16>
 struct StencilLanes {
   static constexpr int support = Shape::support;
