@@ -80,10 +80,11 @@ constexpr bool lean_build = true;
 constexpr bool lean_build = false;
 #endif
 
-// The helpers below run once per particle inside the particle loops, and are
-// forced inline: called, each returned or took its matrices through memory,
-// and the loop stalled reloading them whole from halves just stored (a store
-// is not forwarded to a wider load): 6 % of a B-spline step.
+// The helpers below run inside the particle loops (once per particle, or per
+// chunk of them), and are forced inline: called, each returned or took its
+// matrices through memory, and the loop stalled reloading them whole from
+// halves just stored (a store is not forwarded to a wider load): 6 % of a
+// B-spline step.
 
 // L = grad v from the grid's velocities at the particles of a chunk's
 // lanes, into gradient[particle(lane)].
@@ -378,11 +379,11 @@ void Solver<Dim>::scatter_mass_momentum() {
 #pragma omp for schedule(static)
       for (int c = 0; c < chunks; ++c) {
         const int start = c * Lanes::width, lanes = std::min(Lanes::width, n - start);
-        s.compute(lattice, p.x.data(), p.half_width.data(), [start](int lane) { return start + lane; }, lanes);
+        s.compute(p.x.data(), p.half_width.data(), [start](int lane) { return start + lane; }, lanes);
         for (int lane = 0; lane < lanes; ++lane) {
           // Particles leave the grid at the end of a step; one beyond its ghost
           // nodes here came from outside (a solver built with it there).
-          if (!s.inside(lattice, lane)) {
+          if (!s.inside(lane)) {
             ++outside;
             continue;
           }
@@ -500,7 +501,7 @@ void Solver<Dim>::gather_velocity_gradient() {
     for (int c = 0; c < chunks; ++c) {
       const int start = c * Lanes::width, lanes = std::min(Lanes::width, n - start);
       const auto particle = [start](int lane) { return start + lane; };
-      s.compute(lattice, p.x.data(), p.half_width.data(), particle, lanes);
+      s.compute(p.x.data(), p.half_width.data(), particle, lanes);
       velocity_gradients(velocity_, s, lanes, particle, p.velocity_gradient);
     }
   }
@@ -575,7 +576,7 @@ void Solver<Dim>::scatter_forces() {
 #pragma omp for schedule(static)
     for (int c = 0; c < chunks; ++c) {
       const int start = c * Lanes::width, lanes = std::min(Lanes::width, n - start);
-      s.compute(lattice, p.x.data(), p.half_width.data(), [start](int lane) { return start + lane; }, lanes);
+      s.compute(p.x.data(), p.half_width.data(), [start](int lane) { return start + lane; }, lanes);
       for (int lane = 0; lane < lanes; ++lane) add_forces(p, terms, start + lane, s, lane, f);
     }
   }
@@ -588,9 +589,10 @@ void Solver<Dim>::scatter_forces() {
 // fields are still in cache when its forces are scattered, where three
 // passes would compute the stencils twice and stream the fields three times.
 // It measures faster under quadratic B-splines and no faster under linear
-// shapes, whose stencils cost little to compute again, so those stay on the
-// three passes (mpm_solid/benchmark/compare-c88bc1c-fused.csv; measured
-// again with StencilLanes).
+// shapes, whose stencils cost little to compute again, so shapes of three
+// nodes per direction (B-splines, GIMP) take it and linear ones stay on the
+// three passes (mpm_solid/benchmark/compare-c88bc1c-fused.csv; with
+// StencilLanes, compare-lanes-fused-linear.csv).
 template <int Dim>
 template <class Shape>
 void Solver<Dim>::update_and_scatter(double dt) {
@@ -614,7 +616,7 @@ void Solver<Dim>::update_and_scatter(double dt) {
         const auto chunk = members.subspan(c * chunk_size, std::min(chunk_size, n - c * chunk_size));
         const int lanes = static_cast<int>(chunk.size());
         const auto particle = [&chunk](int lane) { return chunk[static_cast<std::size_t>(lane)]; };
-        s.compute(lattice, p.x.data(), p.half_width.data(), particle, lanes);
+        s.compute(p.x.data(), p.half_width.data(), particle, lanes);
         velocity_gradients(velocity_, s, lanes, particle, p.velocity_gradient);
         const Dissipation d = materials_[m]->update_chunk(p, chunk, dt);
         plastic += d.plastic;
@@ -916,7 +918,7 @@ void Solver<Dim>::gather_motion(double dt) {
 #pragma omp for schedule(static)
       for (int c = 0; c < chunks; ++c) {
         const int start = c * Lanes::width, lanes = std::min(Lanes::width, n - start);
-        s.compute(lattice, p.x.data(), p.half_width.data(), [start](int lane) { return start + lane; }, lanes);
+        s.compute(p.x.data(), p.half_width.data(), [start](int lane) { return start + lane; }, lanes);
         alignas(64) double v_pic[Dim][Lanes::width] = {}, dv[Dim][Lanes::width] = {}, spread[Lanes::width] = {};
         Lanes::for_each_node([&](int k, const std::array<int, Dim>& a) {
           const std::ptrdiff_t offset = s.offset[k];

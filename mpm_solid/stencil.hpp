@@ -92,14 +92,15 @@ struct StencilLanes {
   static constexpr int count = Stencil<Dim, Shape>::count;
   static constexpr int width = Width;
 
+  const Lattice<Dim>& lattice;
+  const double inv_h;
   std::array<std::ptrdiff_t, count> offset;  // of node k from the lowest node, in flat indices
-  double inv_h;
   alignas(64) std::int64_t first[Width];     // flat index of each lane's lowest node
   alignas(64) int base[Dim][Width];          // grid coordinates of each lane's lowest node
   alignas(64) double w[Dim][support][Width];
   alignas(64) double dw[Dim][support][Width];  // d w / d xi (per cell)
 
-  explicit StencilLanes(const Lattice<Dim>& g) : inv_h(g.inv_h) {
+  explicit StencilLanes(const Lattice<Dim>& g) : lattice(g), inv_h(g.inv_h) {
     const std::ptrdiff_t row = g.nodes_along[0], plane = Dim == 3 ? row * g.nodes_along[1] : 0;
     for_each_node([&](int k, const std::array<int, Dim>& a) {
       offset[k] = a[0] + a[1] * row + (Dim == 3 ? a[Dim - 1] * plane : 0);
@@ -122,17 +123,25 @@ struct StencilLanes {
   }
 
   // Lanes 0 .. lanes-1 from particles particle(0), particle(1), ... of the
-  // positions x and half-widths (in cells); inside() says whether each
-  // lane's support lies in the ghost-padded grid.
+  // positions x and half-widths (in cells). inside() says whether each
+  // lane's support lies in the ghost-padded grid: where it does not, first
+  // and offset point outside the nodal arrays. A step's first pass (the mass
+  // scatter) refuses such particles, and positions change only at its end,
+  // so the passes after it read and write the nodes unchecked.
   template <class Index>
-  void compute(const Lattice<Dim>& g, const Vec<Dim>* x, const double* half_width, Index particle, int lanes) {
+  void compute(const Vec<Dim>* x, const double* half_width, Index particle, int lanes) {
+    // Locals: read through the lattice, these would be loaded again for
+    // every lane, after every store into the lanes' arrays.
+    const Vec<Dim> lower = lattice.lower;
+    const double inv_h = this->inv_h;
+    const std::array<int, Dim> nodes_along = lattice.nodes_along;
 #pragma omp simd
     for (int lane = 0; lane < lanes; ++lane) {
       const auto i = particle(lane);
       std::int64_t flat = 0;
 #pragma GCC unroll 3
       for (int d = Dim - 1; d >= 0; --d) {
-        const double xi = (x[i][d] - g.lower[d]) * inv_h + Grid<Dim>::ghost;
+        const double xi = (x[i][d] - lower[d]) * inv_h + Grid<Dim>::ghost;
         double wd[support], dwd[support];
         const int base = Shape::eval(xi, half_width[i], wd, dwd);
 #pragma GCC unroll 3
@@ -140,7 +149,7 @@ struct StencilLanes {
           w[d][a][lane] = wd[a];
           dw[d][a][lane] = dwd[a];
         }
-        flat = flat * g.nodes_along[d] + base;
+        flat = flat * nodes_along[d] + base;
         this->base[d][lane] = base;
       }
       first[lane] = flat;
@@ -149,9 +158,9 @@ struct StencilLanes {
 
   // Whether every node of the lane's support lies inside the ghost-padded
   // grid (else `first` and `offset` point outside the nodal arrays).
-  bool inside(const Lattice<Dim>& g, int lane) const {
+  bool inside(int lane) const {
     bool in = true;
-    for (int d = 0; d < Dim; ++d) in = in && base[d][lane] >= 0 && base[d][lane] + support <= g.nodes_along[d];
+    for (int d = 0; d < Dim; ++d) in = in && base[d][lane] >= 0 && base[d][lane] + support <= lattice.nodes_along[d];
     return in;
   }
   std::array<int, Dim> lowest(int lane) const {
