@@ -86,6 +86,19 @@ constexpr bool lean_build = false;
 // halves just stored (a store is not forwarded to a wider load): 6 % of a
 // B-spline step.
 
+// f(start, lanes) over the particles in chunks of s's width, s computed for
+// each: the threads of the enclosing parallel region share the chunks.
+template <int Dim, class Shape, int Width, class F>
+[[gnu::always_inline]] inline void over_chunks(StencilLanes<Dim, Shape, Width>& s, const Particles<Dim>& p, F&& f) {
+  const int n = static_cast<int>(p.size()), chunks = (n + Width - 1) / Width;
+#pragma omp for schedule(static)
+  for (int c = 0; c < chunks; ++c) {
+    const int start = c * Width, lanes = std::min(Width, n - start);
+    s.compute(p.x.data(), p.half_width.data(), [start](int lane) { return start + lane; }, lanes);
+    f(start, lanes);
+  }
+}
+
 // L = grad v from the grid's velocities at the particles of a chunk's
 // lanes, into gradient[particle(lane)].
 template <int Dim, class Shape, int Width, class Index>
@@ -373,13 +386,8 @@ void Solver<Dim>::scatter_mass_momentum() {
     const auto strides = active_.strides();
     const Lattice<Dim> lattice(grid_);
     if constexpr (!Apic) {
-      using Lanes = StencilLanes<Dim, Shape>;
-      Lanes s(lattice);
-      const int chunks = (n + Lanes::width - 1) / Lanes::width;
-#pragma omp for schedule(static)
-      for (int c = 0; c < chunks; ++c) {
-        const int start = c * Lanes::width, lanes = std::min(Lanes::width, n - start);
-        s.compute(p.x.data(), p.half_width.data(), [start](int lane) { return start + lane; }, lanes);
+      StencilLanes<Dim, Shape> s(lattice);
+      over_chunks(s, p, [&](int start, int lanes) {
         for (int lane = 0; lane < lanes; ++lane) {
           // Particles leave the grid at the end of a step; one beyond its ghost
           // nodes here came from outside (a solver built with it there).
@@ -399,7 +407,7 @@ void Solver<Dim>::scatter_mass_momentum() {
             mv_at[s.offset[k]] += wm * v;
           });
         }
-      }
+      });
     } else {
       Stencil<Dim, Shape> s;
 #pragma omp for schedule(static)
@@ -490,20 +498,13 @@ template <int Dim>
 template <class Shape>
 void Solver<Dim>::gather_velocity_gradient() {
   auto& p = particles_;
-  const int n = static_cast<int>(p.size());
-  using Lanes = StencilLanes<Dim, Shape>;
-  const int chunks = (n + Lanes::width - 1) / Lanes::width;
 #pragma omp parallel
   {
     const Lattice<Dim> lattice(grid_);
-    Lanes s(lattice);
-#pragma omp for schedule(static)
-    for (int c = 0; c < chunks; ++c) {
-      const int start = c * Lanes::width, lanes = std::min(Lanes::width, n - start);
-      const auto particle = [start](int lane) { return start + lane; };
-      s.compute(p.x.data(), p.half_width.data(), particle, lanes);
-      velocity_gradients(velocity_, s, lanes, particle, p.velocity_gradient);
-    }
+    StencilLanes<Dim, Shape> s(lattice);
+    over_chunks(s, p, [&](int start, int lanes) {
+      velocity_gradients(velocity_, s, lanes, [start](int lane) { return start + lane; }, p.velocity_gradient);
+    });
   }
 }
 
@@ -562,23 +563,17 @@ template <int Dim>
 template <class Shape>
 void Solver<Dim>::scatter_forces() {
   const auto& p = particles_;
-  const int n = static_cast<int>(p.size());
   const ForceTerms<Dim> terms = force_terms(p, settings_);
   Scatter<Vec<Dim>> forces{thread_vector_, force_, active_.runs()};
   forces.clear();
-  using Lanes = StencilLanes<Dim, Shape>;
-  const int chunks = (n + Lanes::width - 1) / Lanes::width;
 #pragma omp parallel num_threads(threads_)
   {
     auto& f = forces.buffer(omp_get_thread_num());
     const Lattice<Dim> lattice(grid_);
-    Lanes s(lattice);
-#pragma omp for schedule(static)
-    for (int c = 0; c < chunks; ++c) {
-      const int start = c * Lanes::width, lanes = std::min(Lanes::width, n - start);
-      s.compute(p.x.data(), p.half_width.data(), [start](int lane) { return start + lane; }, lanes);
+    StencilLanes<Dim, Shape> s(lattice);
+    over_chunks(s, p, [&](int start, int lanes) {
       for (int lane = 0; lane < lanes; ++lane) add_forces(p, terms, start + lane, s, lane, f);
-    }
+    });
   }
   forces.gather();
   fold_ghosts(nullptr, force_);
@@ -907,7 +902,6 @@ void Solver<Dim>::gather_motion(double dt) {
     }
   } else {
     using Lanes = StencilLanes<Dim, Shape>;
-    const int chunks = (n + Lanes::width - 1) / Lanes::width;
     const double *now = velocity_.data()->data(), *next = velocity_new_.data()->data();
 #pragma omp parallel reduction(merge : census) reduction(+ : lost, work, gained)
     {
@@ -915,10 +909,7 @@ void Solver<Dim>::gather_motion(double dt) {
       Lanes s(lattice);
       const Mat<Dim> b = Mat<Dim>::Zero();
       const Vec<Dim> d = Vec<Dim>::Zero();
-#pragma omp for schedule(static)
-      for (int c = 0; c < chunks; ++c) {
-        const int start = c * Lanes::width, lanes = std::min(Lanes::width, n - start);
-        s.compute(p.x.data(), p.half_width.data(), [start](int lane) { return start + lane; }, lanes);
+      over_chunks(s, p, [&](int start, int lanes) {
         alignas(64) double v_pic[Dim][Lanes::width] = {}, dv[Dim][Lanes::width] = {}, spread[Lanes::width] = {};
         Lanes::for_each_node([&](int k, const std::array<int, Dim>& a) {
           const std::ptrdiff_t offset = s.offset[k];
@@ -945,7 +936,7 @@ void Solver<Dim>::gather_motion(double dt) {
           }
           finish(start + lane, pic, change, spread[lane], 0.0, b, d, census, lost, work, gained);
         }
-      }
+      });
     }
   }
   if constexpr (Move) census_ = census;
