@@ -15,6 +15,8 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "common/scene.hpp"
@@ -145,19 +147,127 @@ template <int Dim>
     return none;
 }
 
-// The elastic trial step shared by the elastic-plastic models: Jaumann-rate
-// linear elasticity with Lame constants lambda and G over dt, in place.
-// Inline, with the other kernels below, so that each model's update compiles
-// them into its own loop.
+// f(std::integral_constant<int, 0>{}), ..., f(std::integral_constant<int, N - 1>{}):
+// a small loop written out at compile time.
+template <int N, class F>
+[[gnu::always_inline]] inline void unrolled(F&& f) {
+  [&]<int... I>(std::integer_sequence<int, I...>) {
+    (f(std::integral_constant<int, I>{}), ...);
+  }(std::make_integer_sequence<int, N>{});
+}
+
+// a b + c as Eigen's packet products form it: one rounding where the CPU
+// fuses them (Eigen's pmadd), two where it does not.
+[[gnu::always_inline]] inline double packet_madd(double a, double b, double c) {
+#ifdef __FMA__
+  return std::fma(a, b, c);
+#else
+  return a * b + c;
+#endif
+}
+
+// The step's kinematics and elastic trial of particles index(0), ...,
+// index(n - 1), shared by every model: F <- (I + dt L) F, V = V0 det F, and
+// the Jaumann-rate linear elastic trial of `stress` (and, in the plane, its
+// zz part) with Lame constants lambda and G, both scaled by the particle's
+// stiffness(i) (a heterogeneous draw). One particle per SIMD lane; each
+// particle's arithmetic is Eigen's for the same expressions, to the bit (its
+// evaluation order, and its fused products for 2 x 2 matrices), so that the
+// lanes move no result.
+template <int Dim, class Index, class Stiffness>
+[[gnu::always_inline]] inline void deform_and_trial(Particles<Dim>& p, int n, Index index, Stiffness stiffness,
+                                                    double dt, double lambda, double shear, Mat<Dim>* stress,
+                                                    double* stress_zz) {
+  constexpr int entries = Dim * Dim;
+  // Entry e = r + Dim c of a matrix is (r, c): Eigen's column-major order.
+  constexpr auto at = [](int r, int c) { return r + Dim * c; };
+  constexpr auto diagonal = [](int e) { return e % (Dim + 1) == 0 ? 1.0 : 0.0; };
+  double* const l_all = p.velocity_gradient.data()->data();
+  double* const f_all = p.deformation.data()->data();
+  double* const s_all = stress->data();
+#pragma omp simd
+  for (int k = 0; k < n; ++k) {
+    // Straight-line code (the small loops written out at compile time),
+    // which GCC vectorises over the particles where it leaves nested loops
+    // alone.
+    const std::ptrdiff_t i = index(k);
+    const double* l = l_all + entries * i;
+    double* f = f_all + entries * i;
+    double* s = s_all + entries * i;
+    // F <- (I + dt L) F as Eigen forms it: a column's leading pair of rows
+    // in a packet (fused multiply-adds over the inner index), the third row
+    // of a 3 x 3 coefficient-wise (the inner sum split in halves).
+    double a[entries], g[entries];
+    unrolled<entries>([&](auto e) { a[e] = diagonal(e) + dt * l[e]; });
+    unrolled<entries>([&](auto e) {
+      constexpr int r = e % Dim, c = e / Dim;
+      if constexpr (Dim == 2)
+        g[e] = packet_madd(a[at(r, 1)], f[at(1, c)], a[at(r, 0)] * f[at(0, c)]);
+      else if constexpr (r < 2)
+        g[e] = packet_madd(a[at(r, 2)], f[at(2, c)], packet_madd(a[at(r, 1)], f[at(1, c)], a[at(r, 0)] * f[at(0, c)]));
+      else
+        g[e] = a[at(r, 0)] * f[at(0, c)] + (a[at(r, 1)] * f[at(1, c)] + a[at(r, 2)] * f[at(2, c)]);
+    });
+    double det;
+    if constexpr (Dim == 2) {
+      det = g[at(0, 0)] * g[at(1, 1)] - g[at(1, 0)] * g[at(0, 1)];
+    } else {
+      const auto minor = [&](int a0, int b, int c) {
+        return g[at(0, a0)] * (g[at(1, b)] * g[at(2, c)] - g[at(1, c)] * g[at(2, b)]);
+      };
+      det = minor(0, 1, 2) - minor(1, 0, 2) + minor(2, 0, 1);
+    }
+    unrolled<entries>([&](auto e) { f[e] = g[e]; });
+    p.volume[i] = p.volume0[i] * det;
+    // sigma' = sigma + dt (lambda tr(D) I + 2 G D + W sigma - sigma W), D and
+    // W the symmetric and skew parts of L (plane strain: d_zz = 0).
+    const double scale = stiffness(i);
+    const double lam = scale * lambda, g2 = 2 * (scale * shear);
+    double d[entries], w[entries], rot[entries];
+    unrolled<entries>([&](auto e) {
+      constexpr int r = e % Dim, c = e / Dim;
+      d[e] = 0.5 * (l[e] + l[at(c, r)]);
+      w[e] = 0.5 * (l[e] - l[at(c, r)]);
+    });
+    const double trace = Dim == 2 ? d[0] + d[3] : d[0] + (d[4] + d[8]);
+    const double volumetric = lam * trace;
+    unrolled<entries>([&](auto e) {
+      constexpr int r = e % Dim, c = e / Dim;
+      // W sigma - sigma W: Eigen's packet products in the plane (a fused
+      // multiply-add over the inner index), coefficient ones in 3D.
+      if constexpr (Dim == 2)
+        rot[e] = packet_madd(w[at(r, 1)], s[at(1, c)], w[at(r, 0)] * s[at(0, c)]) -
+                 packet_madd(s[at(r, 1)], w[at(1, c)], s[at(r, 0)] * w[at(0, c)]);
+      else
+        rot[e] = (w[at(r, 0)] * s[at(0, c)] + (w[at(r, 1)] * s[at(1, c)] + w[at(r, 2)] * s[at(2, c)])) -
+                 (s[at(r, 0)] * w[at(0, c)] + (s[at(r, 1)] * w[at(1, c)] + s[at(r, 2)] * w[at(2, c)]));
+    });
+    unrolled<entries>([&](auto e) { s[e] += dt * (volumetric * diagonal(e) + g2 * d[e] + rot[e]); });
+    if constexpr (Dim == 2) stress_zz[i] += dt * lam * trace;
+  }
+}
+
+// The same over a chunk of a material's members; the particles of a
+// material created together (every material, unless bodies of two
+// interleave) run as a block, reached by position.
 template <int Dim>
-inline void elastic_trial(double lambda, double shear, const Mat<Dim>& l, double dt, Mat<Dim>& s, double& s_zz) {
-  const Mat<Dim> d = 0.5 * (l + l.transpose());  // rate of deformation
-  const Mat<Dim> w = 0.5 * (l - l.transpose());  // spin
-  const double trace = d.trace();                 // plane strain: d_zz = 0
-  // sigma' = sigma + dt (C : D + W sigma - sigma W)
-  const Mat<Dim> rotation = w * s - s * w;
-  s += dt * (lambda * trace * Mat<Dim>::Identity() + 2 * shear * d + rotation);
-  if constexpr (Dim == 2) s_zz += dt * lambda * trace;
+void deform_and_trial(Particles<Dim>& p, std::span<const int> members, double dt, double lambda, double shear,
+                      const std::vector<double>* stiffness, std::vector<Mat<Dim>>& stress,
+                      std::vector<double>& stress_zz) {
+  if (members.empty()) return;
+  const int n = static_cast<int>(members.size());
+  double* zz = Dim == 2 ? stress_zz.data() : nullptr;
+  const auto with = [&](auto index) {
+    if (stiffness)
+      deform_and_trial(p, n, index, [scale = stiffness->data()](std::ptrdiff_t i) { return scale[i]; }, dt, lambda,
+                       shear, stress.data(), zz);
+    else
+      deform_and_trial(p, n, index, [](std::ptrdiff_t) { return 1.0; }, dt, lambda, shear, stress.data(), zz);
+  };
+  if (const int first = members.front(); members.back() - first == n - 1)
+    with([first](int k) { return first + k; });
+  else
+    with([members](int k) { return members[static_cast<std::size_t>(k)]; });
 }
 
 // Mean stress and deviator (plane strain: zz included in both).
@@ -238,21 +348,12 @@ inline double drucker_prager_return(double alpha, double k, double alpha_dilatio
 // holds them, take 7 kB in the plane and 11 kB in 3D).
 inline constexpr int chunk_size = 64;
 
-// Runs update(i), the stress update of particle i returning what it
-// dissipated, over `members` in turn, after carrying the particle's
-// deformation gradient and volume over the step: one pass over the particles
-// serves kinematics and constitution.
-template <int Dim, class Update>
-Dissipation each_member(Particles<Dim>& p, std::span<const int> members, double dt, Update&& update) {
+// Runs update(i), what remains of particle i's stress update after
+// deform_and_trial, returning what it dissipated, over `members` in turn.
+template <class Update>
+Dissipation each_member(std::span<const int> members, Update&& update) {
   Dissipation total;
-  for (const int i : members) {
-    // Into a local first: the product evaluated straight into the particle's
-    // field goes through a temporary and back through memory.
-    const Mat<Dim> f = (Mat<Dim>::Identity() + dt * p.velocity_gradient[i]) * p.deformation[i];
-    p.deformation[i] = f;
-    p.volume[i] = p.volume0[i] * f.determinant();
-    total += update(i);
-  }
+  for (const int i : members) total += update(i);
   return total;
 }
 

@@ -30,11 +30,10 @@ template <int Dim>
 Dissipation DruckerPrager<Dim>::update_chunk(Particles<Dim>& p, std::span<const int> members, double dt) const {
   // Equivalent plastic strain per unit multiplier: sqrt(2/3 |dg/dsigma|^2).
   const double strain_per_multiplier = std::sqrt(2.0 / 3.0 * (0.5 + alpha_dilation_ * alpha_dilation_ / 3));
-  const double lambda = this->lame_lambda(), shear = this->shear_modulus();
-  return each_member(p, members, dt, [&](int i) {
+  deform_and_trial(p, members, dt, this->lame_lambda(), this->shear_modulus(), nullptr, p.stress, p.stress_zz);
+  return each_member(members, [&](int i) {
     double none = 0;
     double& zz = out_of_plane<Dim>(p.stress_zz, i, none);
-    elastic_trial<Dim>(lambda, shear, p.velocity_gradient[i], dt, p.stress[i], zz);
     double work = 0;
     const double multiplier = return_map(p.stress[i], zz, &work);
     if (multiplier == 0) return Dissipation{};

@@ -4,12 +4,8 @@ namespace outburst::mpm {
 
 template <int Dim>
 Dissipation LinearElastic<Dim>::update_chunk(Particles<Dim>& p, std::span<const int> members, double dt) const {
-  const double lambda = this->lame_lambda(), shear = this->shear_modulus();
-  return each_member(p, members, dt, [&](int i) {
-    double none = 0;
-    elastic_trial<Dim>(lambda, shear, p.velocity_gradient[i], dt, p.stress[i], out_of_plane<Dim>(p.stress_zz, i, none));
-    return Dissipation{};
-  });
+  deform_and_trial(p, members, dt, this->lame_lambda(), this->shear_modulus(), nullptr, p.stress, p.stress_zz);
+  return {};
 }
 
 template class LinearElastic<2>;

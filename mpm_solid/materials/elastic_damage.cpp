@@ -269,11 +269,11 @@ double ElasticDamage<Dim>::modulus_scale(const Particles<Dim>& p, int i) const {
 }
 
 template <int Dim>
-void ElasticDamage<Dim>::trial(Particles<Dim>& p, int i, double dt) const {
-  const double stiffness = modulus_scale(p, i);  // lambda and G scale with E
-  double none = 0;
-  elastic_trial<Dim>(stiffness * this->lame_lambda(), stiffness * this->shear_modulus(), p.velocity_gradient[i], dt,
-                     p.effective_stress[i], out_of_plane<Dim>(p.effective_stress_zz, i, none));
+void ElasticDamage<Dim>::trial(Particles<Dim>& p, std::span<const int> members, double dt) const {
+  // lambda and G scale with E
+  deform_and_trial(p, members, dt, this->lame_lambda(), this->shear_modulus(),
+                   parameters_.heterogeneity ? &p.modulus_scale : nullptr, p.effective_stress,
+                   p.effective_stress_zz);
 }
 
 // The acting stress at damage d, what the growth of damage took, and the
@@ -336,8 +336,8 @@ Dissipation ElasticDamage<Dim>::settle(Particles<Dim>& p, int i, double d) const
 template <int Dim>
 Dissipation ElasticDamage<Dim>::update_chunk(Particles<Dim>& p, std::span<const int> members, double dt) const {
   if (!pointwise()) throw std::logic_error("nonlocal damage updates a material's particles together (update_stress)");
-  return each_member(p, members, dt, [&](int i) {
-    trial(p, i, dt);
+  trial(p, members, dt);
+  return each_member(members, [&](int i) {
     const double zz = Dim == 2 ? p.effective_stress_zz[i] : 0.0;
     return settle(p, i, damage(p.damage[i], p.effective_stress[i], zz, strength_scale(p, i), modulus_scale(p, i)));
   });
@@ -349,8 +349,8 @@ Dissipation ElasticDamage<Dim>::update_stress(Particles<Dim>& p, const std::vect
   // Nonlocal: every member's trial stress and driving strain first, then
   // their averages over the internal length, then the damage.
   over_chunks(members, [&](std::span<const int> part) {
-    return each_member(p, part, dt, [&](int i) {
-      trial(p, i, dt);
+    trial(p, part, dt);
+    return each_member(part, [&](int i) {
       const double zz = Dim == 2 ? p.effective_stress_zz[i] : 0.0;
       p.nonlocal_strain[i] = driving_strain(p.effective_stress[i], zz, strength_scale(p, i), modulus_scale(p, i));
       return Dissipation{};

@@ -129,8 +129,9 @@ class ElasticDamage final : public Material<Dim> {
 
   double strength_scale(const Particles<Dim>& p, int i) const;  // s_f, 1 unless heterogeneous
   double modulus_scale(const Particles<Dim>& p, int i) const;   // s_E
-  // The elastic trial of particle i's undamaged stress over dt.
-  void trial(Particles<Dim>& p, int i, double dt) const;
+  // The step's kinematics and the elastic trial of the members' undamaged
+  // stresses over dt.
+  void trial(Particles<Dim>& p, std::span<const int> members, double dt) const;
   // Sets particle i's damage to d (no less than it had) and its acting
   // stress, and returns what that dissipated.
   Dissipation settle(Particles<Dim>& p, int i, double d) const;
