@@ -460,6 +460,8 @@ def outburst_cost(rows):
 block("outburst cost after 3d", "cases/outburst/benchmark/outburst-benchmark-after-3d.csv")(outburst_cost)
 block("outburst cost stencil lanes", "cases/outburst/benchmark/outburst-benchmark-stencil-lanes.csv")(outburst_cost)
 block("mpm benchmark stencil lanes", "mpm_solid/benchmark/compare-63e0ffd-53491f2-b1c4128.csv")(mpm_benchmark_builds)
+block("outburst cost trial lanes", "cases/outburst/benchmark/outburst-benchmark-trial-lanes.csv")(outburst_cost)
+block("mpm benchmark trial lanes", "mpm_solid/benchmark/compare-63e0ffd-78f1b01-a1314c5.csv")(mpm_benchmark_builds)
 
 
 @block("mpm benchmark", "mpm_solid/benchmark/mpm-benchmark.csv")
