@@ -95,7 +95,7 @@ void lanes_match_one_particle_at_a_time(bool draws) {
 }  // namespace
 
 TEST_CASE("the chunked kinematics and elastic trial give each particle its own step, to round-off, in the plane "
-          "and in 3D; members in a block or scattered, to the bit",
+          "and in 3D, and members in a block or scattered the same bits",
           "[mpm][material]") {
   for (const bool draws : {false, true}) {
     INFO("a stiffness draw per particle: " << draws);
