@@ -9,7 +9,9 @@
 // a new model is one file and its test.
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
@@ -170,26 +172,33 @@ template <int N, class F>
 // index(n - 1), shared by every model: F <- (I + dt L) F, V = V0 det F, and
 // the Jaumann-rate linear elastic trial of `stress` (and, in the plane, its
 // zz part) with Lame constants lambda and G, both scaled by the particle's
-// stiffness(i) (a heterogeneous draw). One particle per SIMD lane; each
-// particle's arithmetic is Eigen's for the same expressions, to the bit (its
+// stiffness(i) (a heterogeneous draw). In the plane one particle per SIMD
+// lane, each particle's arithmetic Eigen's for the same expressions (its
 // evaluation order, and its fused products for 2 x 2 matrices), so that the
-// lanes move no result.
+// lanes move no result: the same bits, where the compiler fuses no products
+// of its own (-DOUTBURST_NO_FP_CONTRACTION=ON, scripts/compare-builds.sh). In
+// 3D one particle at a time: a particle's nine entries, 72 bytes apart, make
+// GCC's vector loads gathers, and the lanes ran a linear elastic 3D step 9 %
+// slower. The 3D order is Eigen's too, but for the Jaumann rotation's
+// products, which Eigen fused in some contexts and not in others: a few
+// stress entries moved by an ulp.
 template <int Dim, class Index, class Stiffness>
 [[gnu::always_inline]] inline void deform_and_trial(Particles<Dim>& p, int n, Index index, Stiffness stiffness,
                                                     double dt, double lambda, double shear, Mat<Dim>* stress,
                                                     double* stress_zz) {
   constexpr int entries = Dim * Dim;
-  // Entry e = r + Dim c of a matrix is (r, c): Eigen's column-major order.
+  // Entry e = r + Dim c of a matrix is (r, c): Eigen's column-major order,
+  // and the matrices of a field follow each other unpadded.
+  static_assert(!Mat<Dim>::IsRowMajor && sizeof(Mat<Dim>) == entries * sizeof(double));
   constexpr auto at = [](int r, int c) { return r + Dim * c; };
   constexpr auto diagonal = [](int e) { return e % (Dim + 1) == 0 ? 1.0 : 0.0; };
   double* const l_all = p.velocity_gradient.data()->data();
   double* const f_all = p.deformation.data()->data();
   double* const s_all = stress->data();
-#pragma omp simd
+#pragma omp simd if(Dim == 2)
   for (int k = 0; k < n; ++k) {
-    // Straight-line code (the small loops written out at compile time),
-    // which GCC vectorises over the particles where it leaves nested loops
-    // alone.
+    // Straight-line code (the small loops written out at compile time): GCC
+    // vectorises it over the particles where it leaves nested loops alone.
     const std::ptrdiff_t i = index(k);
     const double* l = l_all + entries * i;
     double* f = f_all + entries * i;
@@ -247,13 +256,15 @@ template <int Dim, class Index, class Stiffness>
   }
 }
 
-// The same over a chunk of a material's members; the particles of a
-// material created together (every material, unless bodies of two
+// The same over a chunk of a material's members, in increasing order, none
+// twice (as material_members lists them): the lanes write each its own
+// particle, and consecutive members (every material, unless bodies of two
 // interleave) run as a block, reached by position.
 template <int Dim>
 void deform_and_trial(Particles<Dim>& p, std::span<const int> members, double dt, double lambda, double shear,
                       const std::vector<double>* stiffness, std::vector<Mat<Dim>>& stress,
                       std::vector<double>& stress_zz) {
+  assert(std::adjacent_find(members.begin(), members.end(), std::greater_equal<>()) == members.end());
   if (members.empty()) return;
   const int n = static_cast<int>(members.size());
   double* zz = Dim == 2 ? stress_zz.data() : nullptr;

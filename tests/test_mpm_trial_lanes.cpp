@@ -10,6 +10,7 @@
 #include <cmath>
 #include <numeric>
 #include <random>
+#include <span>
 #include <vector>
 
 #include "mpm_solid/material.hpp"
@@ -71,23 +72,25 @@ void lanes_match_one_particle_at_a_time(bool draws) {
     if constexpr (Dim == 2)
       worst = std::max(worst, relative(lanes.stress_zz[i], start.stress_zz[i] + dt * lam * d.trace(), s0.norm()));
   }
-  // Round-off apart: the two order a few sums differently (in 3D, where
-  // Eigen's order moves with where its temporaries sit) and may fuse
-  // different products.
+  // Round-off apart: the compiler may fuse different products in the two,
+  // and in 3D Eigen fuses the rotation's products in some contexts only.
   CHECK(worst < 1e-13);
 
   // Members through their indices (a material's particles interleaved with
-  // another's): the same arithmetic, to the bit.
-  std::vector<int> scattered = block;
-  std::shuffle(scattered.begin(), scattered.end(), rng);
+  // another's): every third particle left out. The members' step is the
+  // block's to the bit, and the others are left as they were.
+  std::vector<int> scattered;
+  for (int i = 0; i < n; ++i)
+    if (i % 3 != 1) scattered.push_back(i);
   Particles<Dim> indexed = start;
   deform_and_trial(indexed, std::span<const int>(scattered), dt, lambda, shear, scale, indexed.stress,
                    indexed.stress_zz);
   int differ = 0;
   for (int i = 0; i < n; ++i) {
-    differ += lanes.deformation[i] != indexed.deformation[i] || lanes.stress[i] != indexed.stress[i] ||
-              lanes.volume[i] != indexed.volume[i];
-    if constexpr (Dim == 2) differ += lanes.stress_zz[i] != indexed.stress_zz[i];
+    const Particles<Dim>& expected = i % 3 != 1 ? lanes : start;
+    differ += expected.deformation[i] != indexed.deformation[i] || expected.stress[i] != indexed.stress[i] ||
+              expected.volume[i] != indexed.volume[i];
+    if constexpr (Dim == 2) differ += expected.stress_zz[i] != indexed.stress_zz[i];
   }
   CHECK(differ == 0);
 }
