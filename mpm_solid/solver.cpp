@@ -583,11 +583,11 @@ void Solver<Dim>::scatter_forces() {
 // chunk of each material's particles at a time: the chunk's stencils and
 // fields are still in cache when its forces are scattered, where three
 // passes would compute the stencils twice and stream the fields three times.
-// It measures faster under quadratic B-splines and no faster under linear
-// shapes, whose stencils cost little to compute again, so shapes of three
-// nodes per direction (B-splines, GIMP) take it and linear ones stay on the
-// three passes (mpm_solid/benchmark/compare-c88bc1c-fused.csv; with
-// StencilLanes, compare-lanes-fused-linear.csv).
+// It measured faster under quadratic B-splines from the start
+// (mpm_solid/benchmark/compare-c88bc1c-fused.csv) and under linear shapes,
+// whose stencils cost little to compute again, once the materials' trial ran
+// over lanes (compare-fused-linear-b53d828.csv; before, no faster:
+// compare-lanes-fused-linear.csv).
 template <int Dim>
 template <class Shape>
 void Solver<Dim>::update_and_scatter(double dt) {
@@ -954,7 +954,7 @@ void Solver<Dim>::step_kernel(double dt) {
   scatter_mass_momentum<Shape, Apic>();
   grid_velocities();
   if constexpr (S == Scheme::usf) {
-    if (pointwise_ && Shape::support > 2) {
+    if (pointwise_) {
       update_and_scatter<Shape>(dt);
     } else {
       gather_velocity_gradient<Shape>();
