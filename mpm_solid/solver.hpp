@@ -335,7 +335,8 @@ class Solver {
   template <class F>
   void over_layer(int axis, int row, F&& f) const;
   void update_stresses(double dt);
-  void count(int i, double dt, Census& census) const;
+  bool book(int i, double dt, Census& census) const;
+  void count(int i, double dt, Census& census) const;  // book, and the fastest signal
   Census move_particles(double dt);
   void remove_escaped(const Census& census, StepInfo& info);
   void rebuild_material_groups();
