@@ -236,13 +236,6 @@ template <int Dim, int Width>
     over_lanes(std::true_type{});
 }
 
-template <int Dim>
-inline double signal_speed(const std::vector<double>& p_modulus, const Particles<Dim>& p, int i) {
-  double speed[1];
-  signal_speeds(p_modulus, p, i, 1, speed);
-  return speed[0];
-}
-
 }  // namespace
 
 template <int Dim>
@@ -814,7 +807,7 @@ double Solver<Dim>::apply_walls(std::vector<Vec<Dim>>& velocity) const {
 }
 
 template <int Dim>
-double Solver<Dim>::runaway_speed_squared(int i) const {
+[[gnu::always_inline]] inline double Solver<Dim>::runaway_speed_squared(int i) const {
   // A stiff draw of a heterogeneous material carries a faster wave; a soft one
   // is still stepped at the stiffest particle's step, so it is held to its
   // material's speed.
@@ -834,29 +827,64 @@ template <class M>
 }
 }  // namespace
 
-// Books a moved particle: the work of a pore pressure on it, and whether it
-// went wrong or left. Returns whether it moved well (finite, on the grid and
-// below its runaway speed): the next step is set by those alone.
+// Books the moved particles start .. start + lanes - 1 (lanes <= Width):
+// the work of a pore pressure on them, whether they went wrong or left, and
+// the fastest signal among those that moved well (finite, on the grid and
+// below their runaway speed), which sets the next step. Over SIMD lanes, the
+// work then summed particle by particle, in order.
 template <int Dim>
-[[gnu::always_inline]] inline bool Solver<Dim>::book(int i, double dt, Census& census) const {
+template <int Width>
+[[gnu::always_inline]] inline void Solver<Dim>::count(int start, int lanes, double dt, Census& census) const {
   const auto& p = particles_;
-  // A pore pressure does work on the skeleton as it dilates.
-  if (!lean_build && !p.pore_pressure.empty())
-    census.external_work += p.pore_pressure[i] * p.volume[i] * p.velocity_gradient[i].trace() * dt;
-  if (!finite(p.x[i]) || !finite(p.v[i]) || !finite(p.stress[i]))
-    ++census.bad;
-  else if (!grid_.inside(p.x[i]))
-    ++census.escaped;
-  else if (p.v[i].squaredNorm() > runaway_speed_squared(i))
-    ++census.runaway;
-  else
-    return true;
-  return false;
-}
-
-template <int Dim>
-[[gnu::always_inline]] inline void Solver<Dim>::count(int i, double dt, Census& census) const {
-  if (book(i, dt, census)) census.fastest = std::max(census.fastest, signal_speed(p_modulus_, particles_, i));
+  alignas(64) double pore_work[Width];
+  alignas(64) char well[Width];
+  long bad = 0, escaped = 0, runaway = 0;
+  const double *x = p.x.data()->data(), *v = p.v.data()->data(), *stress = p.stress.data()->data(),
+               *gradient = p.velocity_gradient.data()->data();
+  const Vec<Dim> lower = grid_.lower, upper = grid_.upper;
+  const auto over_lanes = [&](auto pore) __attribute__((always_inline)) {
+#pragma omp simd reduction(+ : bad, escaped, runaway)
+    for (int lane = 0; lane < lanes; ++lane) {
+      const int i = start + lane;
+      // A pore pressure does work on the skeleton as it dilates.
+      if constexpr (decltype(pore)::value) {
+        double dilatation = gradient[Dim * Dim * i];
+#pragma GCC unroll 2
+        for (int e = 1; e < Dim; ++e) dilatation += gradient[Dim * Dim * i + e * (Dim + 1)];
+        pore_work[lane] = p.pore_pressure[i] * p.volume[i] * dilatation * dt;
+      }
+      bool finite = true, inside = true;
+#pragma GCC unroll 3
+      for (int e = 0; e < Dim; ++e) {
+        const double at = x[Dim * i + e];
+        finite &= std::isfinite(at) & std::isfinite(v[Dim * i + e]);
+        inside &= (at >= lower[e]) & (at <= upper[e]);
+      }
+#pragma GCC unroll 9
+      for (int e = 0; e < Dim * Dim; ++e) finite &= std::isfinite(stress[Dim * Dim * i + e]);
+      double squared = v[Dim * i] * v[Dim * i];
+#pragma GCC unroll 2
+      for (int e = 1; e < Dim; ++e) squared += v[Dim * i + e] * v[Dim * i + e];
+      const bool fast = squared > runaway_speed_squared(i);
+      bad += !finite;
+      escaped += finite & !inside;
+      runaway += finite & inside & fast;
+      well[lane] = finite & inside & !fast;
+    }
+  };
+  if (!lean_build && !p.pore_pressure.empty()) {
+    over_lanes(std::true_type{});
+    for (int lane = 0; lane < lanes; ++lane) census.external_work += pore_work[lane];
+  } else {
+    over_lanes(std::false_type{});
+  }
+  census.bad += bad;
+  census.escaped += escaped;
+  census.runaway += runaway;
+  alignas(64) double speed[Width];
+  signal_speeds(p_modulus_, p, start, lanes, speed);
+  for (int lane = 0; lane < lanes; ++lane)
+    if (well[lane]) census.fastest = std::max(census.fastest, speed[lane]);
 }
 
 #pragma omp declare reduction(merge : Census : omp_out += omp_in)
@@ -872,44 +900,79 @@ void Solver<Dim>::gather_motion(double dt) {
   Census census;
   double lost = 0, work = 0, gained = 0;
   const bool loads = !lean_build && !p.external_force.empty();
-  // Particle i's new velocity (and, under APIC, its B matrix from b and d)
-  // and position from what its stencil gathered, and the energy books: the
-  // calling thread's census and sums, passed in, since a lambda made out here
+  // The new velocities and positions of particles start .. start + lanes - 1
+  // from what their stencils gathered (lane by lane: v_pic, dv, spread and,
+  // under APIC, affine), the energy books and, under Move, the census; the
+  // calling thread's census and sums passed in, since a lambda made out here
   // would capture the shared ones rather than the thread's reduction copies.
-  const auto finish = [&](int i, const Vec<Dim>& v_pic, const Vec<Dim>& dv, double spread, double affine,
-                          const Mat<Dim>& b, const Vec<Dim>& d, Census& census, double& lost, double& work,
-                          double& gained) {
-    // Pure FLIP hands each particle the grid's change, interpolated: its
-    // kinetic energy gains m (v . dv + |dv|^2 / 2), short of the grid's
-    // share m ((v + affine) . dv + sum w |dv_i|^2 / 2) by the increment's
-    // spread over the stencil (and under APIC the affine term). It keeps
-    // what the grid cannot hold (sub-cell velocity differences); the PIC
-    // share, and APIC, replace that with the grid's field. All of it is
-    // what the transfer takes.
-    const Vec<Dim> v_flip = p.v[i] + dv;
-    gained += 0.5 * p.mass[i] * spread;
-    lost += 0.5 * p.mass[i] * (spread - dv.squaredNorm()) + p.mass[i] * affine;
-    if constexpr (!Move) displacement_[i] = dt * v_pic;
-    if constexpr (Apic) {
-      // D is diagonal for tensor-product shapes that reproduce linear fields;
-      // a particle on a linear-shape node has D = 0 along that axis (and B too).
-      p.v[i] = v_pic;
-      for (int c = 0; c < Dim; ++c)
-        p.affine[i].col(c) = d[c] > 1e-12 * grid_.h * grid_.h ? Vec<Dim>(b.col(c) / d[c]) : Vec<Dim>::Zero();
+  // Over SIMD lanes, the sums then taken particle by particle, in order.
+  const auto finish = [&]<int Width>(int start, int lanes, const double(&v_pic)[Dim][Width],
+                                     const double(&dv)[Dim][Width], const double(&spread)[Width],
+                                     const double* affine, Census& census, double& lost, double& work,
+                                     double& gained) __attribute__((always_inline)) {
+    alignas(64) double gain[Width], loss[Width], blend[Width], load_work[Width];
+    double *x = p.x.data()->data(), *v = p.v.data()->data(), *displacement = Move ? nullptr : displacement_.data()->data();
+    const auto over_lanes = [&](auto loaded) __attribute__((always_inline)) {
+#pragma omp simd
+      for (int lane = 0; lane < lanes; ++lane) {
+        const int i = start + lane;
+        const double m = p.mass[i];
+        // Pure FLIP hands each particle the grid's change, interpolated: its
+        // kinetic energy gains m (v . dv + |dv|^2 / 2), short of the grid's
+        // share m ((v + affine) . dv + sum w |dv_i|^2 / 2) by the increment's
+        // spread over the stencil (and under APIC the affine term). It keeps
+        // what the grid cannot hold (sub-cell velocity differences); the PIC
+        // share, and APIC, replace that with the grid's field. All of it is
+        // what the transfer takes.
+        double v_flip[Dim], v_new[Dim];
+#pragma GCC unroll 3
+        for (int e = 0; e < Dim; ++e) {
+          v_flip[e] = v[Dim * i + e] + dv[e][lane];
+          v_new[e] = Apic ? v_pic[e][lane] : flip * v_flip[e] + (1 - flip) * v_pic[e][lane];
+          v[Dim * i + e] = v_new[e];
+        }
+        double change = dv[0][lane] * dv[0][lane], before = v_flip[0] * v_flip[0], after = v_new[0] * v_new[0];
+#pragma GCC unroll 2
+        for (int e = 1; e < Dim; ++e) {
+          change += dv[e][lane] * dv[e][lane];
+          before += v_flip[e] * v_flip[e];
+          after += v_new[e] * v_new[e];
+        }
+        gain[lane] = 0.5 * m * spread[lane];
+        loss[lane] = 0.5 * m * (spread[lane] - change);
+        if constexpr (Apic) loss[lane] += m * affine[lane];
+        blend[lane] = 0.5 * m * (before - after);
+        // The external force works along the way the particle went, at the
+        // grid's velocity halfway through the step (the grid's kinetic energy
+        // changes by f (v + v_new) dt / 2), not its own FLIP-blended one.
+        if constexpr (decltype(loaded)::value) {
+          const double *force = p.external_force[i].data(), *surface = p.surface_force[i].data();
+          double worked = (force[0] + surface[0]) * (dt * (v_pic[0][lane] - 0.5 * dv[0][lane]));
+#pragma GCC unroll 2
+          for (int e = 1; e < Dim; ++e) worked += (force[e] + surface[e]) * (dt * (v_pic[e][lane] - 0.5 * dv[e][lane]));
+          load_work[lane] = worked;
+        }
+#pragma GCC unroll 3
+        for (int e = 0; e < Dim; ++e) {
+          if constexpr (Move)
+            x[Dim * i + e] += dt * v_pic[e][lane];
+          else
+            displacement[Dim * i + e] = dt * v_pic[e][lane];
+        }
+      }
+    };
+    if (loads) {
+      over_lanes(std::true_type{});
+      for (int lane = 0; lane < lanes; ++lane) work += load_work[lane];
     } else {
-      p.v[i] = flip * v_flip + (1 - flip) * v_pic;
+      over_lanes(std::false_type{});
     }
-    lost += 0.5 * p.mass[i] * (v_flip.squaredNorm() - p.v[i].squaredNorm());
-    // The external force works along the way the particle went, at the
-    // grid's velocity halfway through the step (the grid's kinetic energy
-    // changes by f (v + v_new) dt / 2), not its own FLIP-blended one.
-    if (loads) work += (p.external_force[i] + p.surface_force[i]).dot(dt * (v_pic - 0.5 * dv));
-    if constexpr (Move) {
-      const Vec<Dim> moved = dt * v_pic;
-      p.x[i] += moved;
-      return book(i, dt, census);
+    for (int lane = 0; lane < lanes; ++lane) {
+      gained += gain[lane];
+      lost += loss[lane];
+      lost += blend[lane];
     }
-    return false;
+    if constexpr (Move) count<Width>(start, lanes, dt, census);
   };
   if constexpr (Apic) {
 #pragma omp parallel reduction(merge : census) reduction(+ : lost, work, gained)
@@ -936,8 +999,16 @@ void Solver<Dim>::gather_motion(double dt) {
           // its own velocity does not carry, worked by the update.
           affine += s.weight[k] * (p.affine[i] * s.offset[k]).dot(change);
         }
-        if (finish(i, v_pic, dv, spread, affine, b, d, census, lost, work, gained))
-          census.fastest = std::max(census.fastest, signal_speed(p_modulus_, p, i));
+        double pic[Dim][1], change[Dim][1];
+        for (int e = 0; e < Dim; ++e) {
+          pic[e][0] = v_pic[e];
+          change[e][0] = dv[e];
+        }
+        finish(i, 1, pic, change, {spread}, &affine, census, lost, work, gained);
+        // D is diagonal for tensor-product shapes that reproduce linear fields;
+        // a particle on a linear-shape node has D = 0 along that axis (and B too).
+        for (int c = 0; c < Dim; ++c)
+          p.affine[i].col(c) = d[c] > 1e-12 * grid_.h * grid_.h ? Vec<Dim>(b.col(c) / d[c]) : Vec<Dim>::Zero();
       }
     }
   } else {
@@ -947,9 +1018,7 @@ void Solver<Dim>::gather_motion(double dt) {
     {
       const Lattice<Dim> lattice(grid_);
       Lanes s(lattice);
-      const Mat<Dim> b = Mat<Dim>::Zero();
-      const Vec<Dim> d = Vec<Dim>::Zero();
-      over_chunks(s, p, [&](int start, int lanes) {
+      over_chunks(s, p, [&](int start, int lanes) __attribute__((always_inline)) {
         alignas(64) double v_pic[Dim][Lanes::width] = {}, dv[Dim][Lanes::width] = {}, spread[Lanes::width] = {};
         Lanes::for_each_node([&](int k, const std::array<int, Dim>& a) {
           const std::ptrdiff_t offset = s.offset[k];
@@ -968,21 +1037,7 @@ void Solver<Dim>::gather_motion(double dt) {
             spread[lane] += weight * squared;
           }
         });
-        bool moved_well[Lanes::width];
-        for (int lane = 0; lane < lanes; ++lane) {
-          Vec<Dim> pic, change;
-          for (int e = 0; e < Dim; ++e) {
-            pic[e] = v_pic[e][lane];
-            change[e] = dv[e][lane];
-          }
-          moved_well[lane] = finish(start + lane, pic, change, spread[lane], 0.0, b, d, census, lost, work, gained);
-        }
-        if constexpr (Move) {
-          double speed[Lanes::width];
-          signal_speeds(p_modulus_, p, start, lanes, speed);
-          for (int lane = 0; lane < lanes; ++lane)
-            if (moved_well[lane]) census.fastest = std::max(census.fastest, speed[lane]);
-        }
+        finish(start, lanes, v_pic, dv, spread, nullptr, census, lost, work, gained);
       });
     }
   }
@@ -1032,12 +1087,14 @@ void Solver<Dim>::step_kernel(double dt) {
 template <int Dim>
 Census Solver<Dim>::move_particles(double dt) {
   auto& p = particles_;
-  const int n = static_cast<int>(p.size());
+  constexpr int width = 16;
+  const int n = static_cast<int>(p.size()), chunks = (n + width - 1) / width;
   Census census;
 #pragma omp parallel for schedule(static) reduction(merge : census)
-  for (int i = 0; i < n; ++i) {
-    p.x[i] += displacement_[i];
-    count(i, dt, census);
+  for (int c = 0; c < chunks; ++c) {
+    const int start = c * width, end = std::min(n, start + width);
+    for (int i = start; i < end; ++i) p.x[i] += displacement_[i];
+    count<width>(start, end - start, dt, census);
   }
   return census;
 }

@@ -335,8 +335,8 @@ class Solver {
   template <class F>
   void over_layer(int axis, int row, F&& f) const;
   void update_stresses(double dt);
-  bool book(int i, double dt, Census& census) const;
-  void count(int i, double dt, Census& census) const;  // book, and the fastest signal
+  template <int Width>
+  void count(int start, int lanes, double dt, Census& census) const;
   Census move_particles(double dt);
   void remove_escaped(const Census& census, StepInfo& info);
   void rebuild_material_groups();
