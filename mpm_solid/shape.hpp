@@ -16,11 +16,20 @@
 
 namespace outburst::mpm {
 
+// floor(x) as an int, for |x| within int's range: std::floor over SIMD lanes
+// needs -fno-trapping-math from GCC, and without it the stencils' loops over
+// a chunk's particles stayed scalar. The truncation, one lower where it
+// rounded up (x negative and not whole), is the same integer.
+inline int floor_int(double x) {
+  const int t = static_cast<int>(x);
+  return t - (x < t);
+}
+
 struct Linear {
   static constexpr int support = 2;
   static constexpr const char* name = "linear";
   static inline int eval(double xi, double /*lp*/, double* w, double* dw) {
-    const int base = static_cast<int>(std::floor(xi));
+    const int base = floor_int(xi);
     const double f = xi - base;
     w[0] = 1 - f;
     w[1] = f;
@@ -34,7 +43,7 @@ struct Gimp {
   static constexpr int support = 3;
   static constexpr const char* name = "gimp";
   static inline int eval(double xi, double lp, double* w, double* dw) {
-    const int base = static_cast<int>(std::floor(xi - 1 - lp)) + 1;
+    const int base = floor_int(xi - 1 - lp) + 1;
     for (int k = 0; k < 3; ++k) {
       const double r = xi - (base + k);
       const double a = std::abs(r);
@@ -62,7 +71,7 @@ struct Bspline {
   static constexpr int support = 3;
   static constexpr const char* name = "bspline";
   static inline int eval(double xi, double /*lp*/, double* w, double* dw) {
-    const int base = static_cast<int>(std::floor(xi - 0.5));
+    const int base = floor_int(xi - 0.5);
     const double f = xi - base;  // in [0.5, 1.5)
     w[0] = 0.5 * (1.5 - f) * (1.5 - f);
     w[1] = 0.75 - (f - 1) * (f - 1);

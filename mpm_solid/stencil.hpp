@@ -5,6 +5,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <utility>
 
 #include "mpm_solid/grid.hpp"
 
@@ -135,25 +136,37 @@ struct StencilLanes {
     const Vec<Dim> lower = lattice.lower;
     const double inv_h = this->inv_h;
     const std::array<int, Dim> nodes_along = lattice.nodes_along;
+    // The directions written out (along<d>), and floor_int for std::floor:
+    // as a loop, the directions left each lane's weights to scatter stores,
+    // and GCC takes std::floor over lanes only without trapping math; either
+    // kept this loop scalar.
+    const double* position = x->data();
 #pragma omp simd
     for (int lane = 0; lane < lanes; ++lane) {
       const auto i = particle(lane);
       std::int64_t flat = 0;
-#pragma GCC unroll 3
-      for (int d = Dim - 1; d >= 0; --d) {
-        const double xi = (x[i][d] - lower[d]) * inv_h + Grid<Dim>::ghost;
-        double wd[support], dwd[support];
-        const int base = Shape::eval(xi, half_width[i], wd, dwd);
-#pragma GCC unroll 3
-        for (int a = 0; a < support; ++a) {
-          w[d][a][lane] = wd[a];
-          dw[d][a][lane] = dwd[a];
-        }
-        flat = flat * nodes_along[d] + base;
-        this->base[d][lane] = base;
-      }
+      [&]<int... D>(std::integer_sequence<int, D...>) {
+        (along<Dim - 1 - D>(position[Dim * i + Dim - 1 - D], half_width[i], lower, inv_h, nodes_along, lane, flat),
+         ...);
+      }(std::make_integer_sequence<int, Dim>{});
       first[lane] = flat;
     }
+  }
+
+  // Lane `lane`'s weights along direction d, and its lowest node's place.
+  template <int d>
+  [[gnu::always_inline]] void along(double x, double half_width, const Vec<Dim>& lower, double inv_h,
+                                    const std::array<int, Dim>& nodes_along, int lane, std::int64_t& flat) {
+    const double xi = (x - lower[d]) * inv_h + Grid<Dim>::ghost;
+    double wd[support], dwd[support];
+    const int base = Shape::eval(xi, half_width, wd, dwd);
+#pragma GCC unroll 3
+    for (int a = 0; a < support; ++a) {
+      w[d][a][lane] = wd[a];
+      dw[d][a][lane] = dwd[a];
+    }
+    flat = flat * nodes_along[d] + base;
+    this->base[d][lane] = base;
   }
 
   // Whether every node of the lane's support lies inside the ghost-padded
