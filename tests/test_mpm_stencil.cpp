@@ -5,6 +5,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <random>
 #include <vector>
@@ -80,4 +81,18 @@ TEST_CASE("a chunk's stencils give each particle's nodes, weights and gradients 
   lanes_agree_with_particles<3, Linear>();
   lanes_agree_with_particles<3, Gimp>();
   lanes_agree_with_particles<3, Bspline>();
+}
+
+TEST_CASE("floor_int is std::floor as an int: whole numbers, either side of them, negative and signed zeros",
+          "[mpm][stencil]") {
+  std::vector<double> xs{0.0, -0.0, 0.5, -0.5, 1e-300, -1e-300, 2147483646.5, -2147483647.5};
+  for (int k = -1000; k <= 1000; ++k) {
+    const double whole = 0.37 * k - (k % 7);  // whole numbers and fractions on both sides of zero
+    for (const double x : {std::floor(whole), whole})
+      xs.insert(xs.end(), {x, std::nextafter(x, -1e9), std::nextafter(x, 1e9)});
+  }
+  for (const double x : xs) {
+    INFO("x = " << x);
+    CHECK(floor_int(x) == static_cast<int>(std::floor(x)));
+  }
 }
