@@ -465,6 +465,8 @@ block("mpm benchmark trial lanes", "mpm_solid/benchmark/compare-63e0ffd-78f1b01-
 block("mpm benchmark 3d trial lanes", "mpm_solid/benchmark/compare-3d-78f1b01-3d1e790.csv")(mpm_benchmark_builds)
 block("mpm benchmark fused linear", "mpm_solid/benchmark/compare-63e0ffd-78f1b01-edf5ae2.csv")(mpm_benchmark_builds)
 block("mpm benchmark motion lanes", "mpm_solid/benchmark/compare-63e0ffd-e79aca1-aa69a3e.csv")(mpm_benchmark_builds)
+block("mpm benchmark 3d motion lanes", "mpm_solid/benchmark/compare-3d-e79aca1-aa69a3e.csv")(mpm_benchmark_builds)
+block("outburst cost motion lanes", "cases/outburst/benchmark/outburst-benchmark-motion-lanes.csv")(outburst_cost)
 
 
 @block("mpm benchmark", "mpm_solid/benchmark/mpm-benchmark.csv")
