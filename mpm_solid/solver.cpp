@@ -220,7 +220,7 @@ template <int Dim, int Width>
   const auto over_lanes = [&](auto drawn) {
 #pragma omp simd
     for (int lane = 0; lane < lanes; ++lane) {
-      const int i = start + lane;
+      const std::ptrdiff_t i = start + lane;
       const double density = p.mass[i] / p.volume[i];
       double squared = velocity[Dim * i] * velocity[Dim * i];
 #pragma GCC unroll 2
@@ -845,7 +845,7 @@ template <int Width>
   const auto over_lanes = [&](auto pore) __attribute__((always_inline)) {
 #pragma omp simd reduction(+ : bad, escaped, runaway)
     for (int lane = 0; lane < lanes; ++lane) {
-      const int i = start + lane;
+      const std::ptrdiff_t i = start + lane;
       // A pore pressure does work on the skeleton as it dilates.
       if constexpr (decltype(pore)::value) {
         double dilatation = gradient[Dim * Dim * i];
@@ -915,7 +915,7 @@ void Solver<Dim>::gather_motion(double dt) {
     const auto over_lanes = [&](auto loaded) __attribute__((always_inline)) {
 #pragma omp simd
       for (int lane = 0; lane < lanes; ++lane) {
-        const int i = start + lane;
+        const std::ptrdiff_t i = start + lane;
         const double m = p.mass[i];
         // Pure FLIP hands each particle the grid's change, interpolated: its
         // kinetic energy gains m (v . dv + |dv|^2 / 2), short of the grid's

@@ -143,7 +143,7 @@ struct StencilLanes {
     const double* position = x->data();
 #pragma omp simd
     for (int lane = 0; lane < lanes; ++lane) {
-      const auto i = particle(lane);
+      const std::ptrdiff_t i = particle(lane);
       std::int64_t flat = 0;
       [&]<int... D>(std::integer_sequence<int, D...>) {
         (along<Dim - 1 - D>(position[Dim * i + Dim - 1 - D], half_width[i], lower, inv_h, nodes_along, lane, flat),

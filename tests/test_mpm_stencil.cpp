@@ -83,9 +83,39 @@ TEST_CASE("a chunk's stencils give each particle's nodes, weights and gradients 
   lanes_agree_with_particles<3, Bspline>();
 }
 
-TEST_CASE("floor_int is std::floor as an int: whole numbers, either side of them, negative and signed zeros",
+namespace {
+template <class Shape>
+void far_supports_are_refused() {
+  Grid<2> g;
+  g.h = 0.3;
+  g.lower = Vec<2>::Zero();
+  g.cells = {7, 6};
+  g.upper = Vec<2>(7 * g.h, 6 * g.h);
+  // A billion cells and far more off the grid, either side: the lowest node
+  // must land where the support check refuses it, not wrap past int's end.
+  const std::vector<Vec<2>> x{{-3e8, 1.0}, {3e8, 1.0}, {1.0, -1e20}, {1.0, 1e20}, {-6.5e8, 6.5e8}};
+  const std::vector<double> half_width(x.size(), 0.25);
+  const Lattice<2> lattice(g);
+  StencilLanes<2, Shape, 16> lanes(lattice);
+  lanes.compute(x.data(), half_width.data(), [](int lane) { return lane; }, static_cast<int>(x.size()));
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    INFO(Shape::name << ", particle at " << x[i].transpose());
+    CHECK_FALSE(lanes.inside(static_cast<int>(i)));
+    Stencil<2, Shape> one;
+    CHECK_FALSE(one.compute(lattice, x[i], half_width[i]));
+  }
+}
+}  // namespace
+
+TEST_CASE("supports a billion cells or more off the grid are refused, not wrapped onto it", "[mpm][stencil]") {
+  far_supports_are_refused<Linear>();
+  far_supports_are_refused<Gimp>();
+  far_supports_are_refused<Bspline>();
+}
+
+TEST_CASE("floor_int is std::floor as an int within 2^30: whole numbers, either side of them, negative and signed zeros",
           "[mpm][stencil]") {
-  std::vector<double> xs{0.0, -0.0, 0.5, -0.5, 1e-300, -1e-300, 2147483646.5, -2147483647.5};
+  std::vector<double> xs{0.0, -0.0, 0.5, -0.5, 1e-300, -1e-300, 1073741823.5, -1073741823.5};
   for (int k = -1000; k <= 1000; ++k) {
     const double whole = 0.37 * k - (k % 7);  // whole numbers and fractions on both sides of zero
     for (const double x : {std::floor(whole), whole})
@@ -95,4 +125,8 @@ TEST_CASE("floor_int is std::floor as an int: whole numbers, either side of them
     INFO("x = " << x);
     CHECK(floor_int(x) == static_cast<int>(std::floor(x)));
   }
+  // Beyond 2^30 either way it holds there (the supports' test above).
+  CHECK(floor_int(2147483646.5) == 1 << 30);
+  CHECK(floor_int(-2147483647.5) == -(1 << 30) - 1);
+  CHECK(floor_int(-1e20) == -(1 << 30) - 1);
 }
