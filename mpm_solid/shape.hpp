@@ -12,23 +12,27 @@
 // particle half-width lp in cells, and fills `support` weights and their
 // derivatives d/dxi (divide by h for d/dx) for nodes base, base+1, ...
 
-#include <algorithm>
 #include <cmath>
-#include <cstdint>
 
 namespace outburst::mpm {
 
 // floor(x) as an int: std::floor over SIMD lanes needs -fno-trapping-math
 // from GCC, and without it the stencils' loops over a chunk's particles stayed
 // scalar. The truncation, one lower where it rounded up (x negative and not
-// whole), is the same integer. Taken in 64 bits and held within 2^30 either
-// way first, so that a particle a billion cells or more off the grid (or at
-// NaN) fails every support check: nothing wraps past int's end, and no grid
-// has 2^30 nodes along an axis.
+// whole), is the same integer. Off int's range (a particle billions of cells
+// off the grid) x86 converts to the lowest int, and one lower wraps to the
+// highest: unsigned, so that the wrap is defined; the stencils' support check
+// refuses either (supported()).
 inline int floor_int(double x) {
-  constexpr std::int64_t far = std::int64_t{1} << 30;
-  const std::int64_t held = std::clamp<std::int64_t>(static_cast<std::int64_t>(x), -far, far);
-  return static_cast<int>(held - (x < static_cast<double>(held)));
+  const int t = static_cast<int>(x);
+  return static_cast<int>(static_cast<unsigned>(t) - (x < t));
+}
+
+// Whether the nodes base .. base + support - 1 lie within 0 .. nodes - 1:
+// unsigned, so that a negative base or one near int's end (floor_int off the
+// grid) fails too, where base + support would wrap.
+inline bool supported(int base, int support, int nodes) {
+  return static_cast<unsigned>(base) <= static_cast<unsigned>(nodes - support);
 }
 
 struct Linear {

@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "mpm_solid/grid.hpp"
+#include "mpm_solid/shape.hpp"
 
 namespace outburst::mpm {
 
@@ -52,7 +53,7 @@ struct Stencil {
       const double xi = (x[d] - g.lower[d]) * inv_h + Grid<Dim>::ghost;
       base[d] = Shape::eval(xi, half_width, w[d], dw[d]);
       rel[d] = (base[d] - xi) * g.h;
-      if (base[d] < 0 || base[d] + support > g.nodes_along[d]) return false;
+      if (!supported(base[d], support, g.nodes_along[d])) return false;
     }
     int k = 0;
     if constexpr (Dim == 2) {
@@ -173,7 +174,7 @@ struct StencilLanes {
   // grid (else `first` and `offset` point outside the nodal arrays).
   bool inside(int lane) const {
     bool in = true;
-    for (int d = 0; d < Dim; ++d) in = in && base[d][lane] >= 0 && base[d][lane] + support <= lattice.nodes_along[d];
+    for (int d = 0; d < Dim; ++d) in = in && supported(base[d][lane], support, lattice.nodes_along[d]);
     return in;
   }
   std::array<int, Dim> lowest(int lane) const {
