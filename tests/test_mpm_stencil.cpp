@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -113,8 +114,8 @@ TEST_CASE("supports a billion cells or more off the grid are refused, not wrappe
   far_supports_are_refused<Bspline>();
 }
 
-TEST_CASE("floor_int is std::floor as an int: whole numbers, either side of them, negative and signed zeros; off "
-          "int's range, refused by the support check",
+TEST_CASE("floor_int is std::floor as an int (whole numbers, either side of them, negative and signed zeros), and "
+          "off int's range the support check refuses it",
           "[mpm][stencil]") {
   std::vector<double> xs{0.0, -0.0, 0.5, -0.5, 1e-300, -1e-300, 2147483646.5, -2147483647.5};
   for (int k = -1000; k <= 1000; ++k) {
@@ -126,6 +127,16 @@ TEST_CASE("floor_int is std::floor as an int: whole numbers, either side of them
     INFO("x = " << x);
     CHECK(floor_int(x) == static_cast<int>(std::floor(x)));
   }
+  // supported() with values the compiler cannot fold: a base near int's end
+  // must not wrap past the check.
+  volatile int end = std::numeric_limits<int>::max(), lowest = std::numeric_limits<int>::min(), support = 3,
+               nodes = 1000;
+  CHECK_FALSE(supported(end, support, nodes));
+  CHECK_FALSE(supported(lowest, support, nodes));
+  CHECK_FALSE(supported(-1, support, nodes));
+  CHECK(supported(0, support, nodes));
+  CHECK(supported(nodes - support, support, nodes));
+  CHECK_FALSE(supported(nodes - support + 1, support, nodes));
   // Off int's range either way (or NaN), the support check refuses it.
   for (const double x : {-3e9, 3e9, -1e20, 1e20, std::nan("")}) {
     INFO("x = " << x);
