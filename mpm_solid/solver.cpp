@@ -3,6 +3,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <cassert>
 #include <numeric>
 #include <cmath>
 #include <type_traits>
@@ -206,34 +207,43 @@ std::vector<double> p_moduli(const std::vector<std::unique_ptr<Material<Dim>>>& 
   return m;
 }
 
-// The fastest signal at each particle of start .. start + lanes - 1, into
-// speed[lane]: its P wave, which speeds up as the material compresses
-// (density rises) and with a heterogeneous material's draw of the moduli,
-// plus its own speed. Over SIMD lanes: a particle takes two divisions and
-// two square roots, which one at a time held the motion gather on the
-// divider for a fifth of its time (perf, linear elastic). One function for
-// the stable step's pass and the move's census, so the two agree to the bit.
-template <int Dim, int Width>
-[[gnu::always_inline]] inline void signal_speeds(const std::vector<double>& p_modulus, const Particles<Dim>& p,
-                                                 int start, int lanes, double (&speed)[Width]) {
-  const double *modulus = p_modulus.data(), *velocity = p.v.data()->data();
-  const auto over_lanes = [&](auto drawn) {
-#pragma omp simd
-    for (int lane = 0; lane < lanes; ++lane) {
-      const std::ptrdiff_t i = start + lane;
-      const double density = p.mass[i] / p.volume[i];
-      double squared = velocity[Dim * i] * velocity[Dim * i];
+// v . v of a Dim-vector, summed left to right as Eigen's squaredNorm() does,
+// entry(e) its e-th entry: one order for the lanes' loops and the per-particle
+// checks after them, so that they agree to the bit.
+template <int Dim, class Entry>
+[[gnu::always_inline]] inline double sum_of_squares(Entry entry) {
+  double sum = entry(0) * entry(0);
 #pragma GCC unroll 2
-      for (int e = 1; e < Dim; ++e) squared += velocity[Dim * i + e] * velocity[Dim * i + e];
-      double stiffness = modulus[p.material[i]];
-      if constexpr (decltype(drawn)::value) stiffness *= p.modulus_scale[i];
-      speed[lane] = std::sqrt(stiffness / density) + std::sqrt(squared);
-    }
-  };
+  for (int e = 1; e < Dim; ++e) sum += entry(e) * entry(e);
+  return sum;
+}
+
+// The fastest signal at particle i: its P wave, which speeds up as the
+// material compresses (density rises) and with a heterogeneous material's
+// draw of the moduli (Drawn: scale holds the draws), plus its own speed,
+// whose square is given. Two divisions and two square roots: the loops that
+// call it run over SIMD lanes, which one particle at a time held the motion
+// gather on the divider for a fifth of its time (perf, linear elastic). One
+// function for the stable step's pass and the move's census, so the two
+// agree to the bit.
+template <bool Drawn, int Dim>
+[[gnu::always_inline]] inline double signal_speed(const double* p_modulus, const double* scale,
+                                                  const Particles<Dim>& p, std::ptrdiff_t i, double speed_squared) {
+  const double density = p.mass[i] / p.volume[i];
+  double stiffness = p_modulus[p.material[i]];
+  if constexpr (Drawn) stiffness *= scale[i];
+  return std::sqrt(stiffness / density) + std::sqrt(speed_squared);
+}
+
+// f(std::bool_constant<Drawn>{}), Drawn whether the particles carry a
+// heterogeneous material's draws of the moduli: the lanes' loops are
+// compiled for either, with no test inside.
+template <int Dim, class F>
+[[gnu::always_inline]] inline void with_draws(const Particles<Dim>& p, F&& f) {
   if (p.modulus_scale.empty())
-    over_lanes(std::false_type{});
+    f(std::false_type{});
   else
-    over_lanes(std::true_type{});
+    f(std::true_type{});
 }
 
 }  // namespace
@@ -374,16 +384,17 @@ template <int Dim>
 double stable_time_step(const std::vector<std::unique_ptr<Material<Dim>>>& materials,
                         const Particles<Dim>& particles, double h, double courant) {
   const std::vector<double> p_modulus = p_moduli(materials);
-  constexpr int width = 16;
+  const double *modulus = p_modulus.data(), *scale = particles.modulus_scale.data(),
+               *velocity = particles.v.data()->data();
+  const std::ptrdiff_t n = static_cast<std::ptrdiff_t>(particles.size());
   double fastest = 0;
-  const int n = static_cast<int>(particles.size()), chunks = (n + width - 1) / width;
-#pragma omp parallel for schedule(static) reduction(max : fastest)
-  for (int c = 0; c < chunks; ++c) {
-    double speed[width];
-    const int lanes = std::min(width, n - c * width);
-    signal_speeds(p_modulus, particles, c * width, lanes, speed);
-    for (int lane = 0; lane < lanes; ++lane) fastest = std::max(fastest, speed[lane]);
-  }
+  with_draws(particles, [&](auto drawn) {
+#pragma omp parallel for simd schedule(static) reduction(max : fastest)
+    for (std::ptrdiff_t i = 0; i < n; ++i) {
+      const double squared = sum_of_squares<Dim>([&](int e) { return velocity[Dim * i + e]; });
+      fastest = std::max(fastest, signal_speed<decltype(drawn)::value>(modulus, scale, particles, i, squared));
+    }
+  });
   return courant * h / fastest;
 }
 
@@ -827,23 +838,30 @@ template <class M>
 }
 }  // namespace
 
-// Books the moved particles start .. start + lanes - 1 (lanes <= Width):
-// the work of a pore pressure on them, whether they went wrong or left, and
-// the fastest signal among those that moved well (finite, on the grid and
-// below their runaway speed), which sets the next step. Over SIMD lanes, the
-// work then summed particle by particle, in order.
+// Books the moved particles start .. start + lanes - 1: the work of a pore
+// pressure on them, whether they went wrong or left, and the fastest signal
+// among those that moved well (finite, on the grid and below their runaway
+// speed), which sets the next step. Over SIMD lanes, the work then summed
+// particle by particle, in order; the other books are counts and a maximum,
+// which no order changes.
 template <int Dim>
-template <int Width>
 [[gnu::always_inline]] inline void Solver<Dim>::count(int start, int lanes, double dt, Census& census) const {
   const auto& p = particles_;
-  alignas(64) double pore_work[Width];
-  alignas(64) char well[Width];
+  constexpr int most = chunk_lanes;
+  assert(lanes <= most);
+  alignas(64) double pore_work[most];
   long bad = 0, escaped = 0, runaway = 0;
+  double fastest = census.fastest;
+  // Locals: read through the particles inside the loop, the vectors' ends
+  // would be loaded again for every lane, and the loop was left scalar.
   const double *x = p.x.data()->data(), *v = p.v.data()->data(), *stress = p.stress.data()->data(),
-               *gradient = p.velocity_gradient.data()->data();
+               *gradient = p.velocity_gradient.data()->data(), *pore_pressure = p.pore_pressure.data(),
+               *volume = p.volume.data(), *modulus = p_modulus_.data(), *scale = p.modulus_scale.data(),
+               *wave = wave_speed_squared_.data();
+  const int* material = p.material.data();
   const Vec<Dim> lower = grid_.lower, upper = grid_.upper;
-  const auto over_lanes = [&](auto pore) __attribute__((always_inline)) {
-#pragma omp simd reduction(+ : bad, escaped, runaway)
+  const auto over_lanes = [&](auto pore, auto drawn) __attribute__((always_inline)) {
+#pragma omp simd reduction(+ : bad, escaped, runaway) reduction(max : fastest)
     for (int lane = 0; lane < lanes; ++lane) {
       const std::ptrdiff_t i = start + lane;
       // A pore pressure does work on the skeleton as it dilates.
@@ -851,7 +869,7 @@ template <int Width>
         double dilatation = gradient[Dim * Dim * i];
 #pragma GCC unroll 2
         for (int e = 1; e < Dim; ++e) dilatation += gradient[Dim * Dim * i + e * (Dim + 1)];
-        pore_work[lane] = p.pore_pressure[i] * p.volume[i] * dilatation * dt;
+        pore_work[lane] = pore_pressure[i] * volume[i] * dilatation * dt;
       }
       bool finite = true, inside = true;
 #pragma GCC unroll 3
@@ -862,29 +880,32 @@ template <int Width>
       }
 #pragma GCC unroll 9
       for (int e = 0; e < Dim * Dim; ++e) finite &= std::isfinite(stress[Dim * Dim * i + e]);
-      double squared = v[Dim * i] * v[Dim * i];
-#pragma GCC unroll 2
-      for (int e = 1; e < Dim; ++e) squared += v[Dim * i + e] * v[Dim * i + e];
-      const bool fast = squared > runaway_speed_squared(i);
+      const double squared = sum_of_squares<Dim>([&](int e) { return v[Dim * i + e]; });
+      // runaway_speed_squared(i), its draw's test taken out of the loop.
+      double limit = wave[material[i]];
+      if constexpr (decltype(drawn)::value) limit = std::max(1.0, scale[i]) * limit;
+      const bool fast = squared > limit;
       bad += !finite;
       escaped += finite & !inside;
       runaway += finite & inside & fast;
-      well[lane] = finite & inside & !fast;
+      const double speed = signal_speed<decltype(drawn)::value>(modulus, scale, p, i, squared);
+      // A NaN speed (a particle of no volume) is passed over, as std::max does.
+      if (finite & inside & !fast & (speed > fastest)) fastest = speed;
     }
   };
-  if (!lean_build && !p.pore_pressure.empty()) {
-    over_lanes(std::true_type{});
+  const bool pore = !lean_build && !p.pore_pressure.empty();
+  with_draws(p, [&](auto drawn) __attribute__((always_inline)) {
+    if (pore)
+      over_lanes(std::true_type{}, drawn);
+    else
+      over_lanes(std::false_type{}, drawn);
+  });
+  if (pore)
     for (int lane = 0; lane < lanes; ++lane) census.external_work += pore_work[lane];
-  } else {
-    over_lanes(std::false_type{});
-  }
   census.bad += bad;
   census.escaped += escaped;
   census.runaway += runaway;
-  alignas(64) double speed[Width];
-  signal_speeds(p_modulus_, p, start, lanes, speed);
-  for (int lane = 0; lane < lanes; ++lane)
-    if (well[lane]) census.fastest = std::max(census.fastest, speed[lane]);
+  census.fastest = fastest;
 }
 
 #pragma omp declare reduction(merge : Census : omp_out += omp_in)
@@ -931,13 +952,9 @@ void Solver<Dim>::gather_motion(double dt) {
           v_new[e] = Apic ? v_pic[e][lane] : flip * v_flip[e] + (1 - flip) * v_pic[e][lane];
           v[Dim * i + e] = v_new[e];
         }
-        double change = dv[0][lane] * dv[0][lane], before = v_flip[0] * v_flip[0], after = v_new[0] * v_new[0];
-#pragma GCC unroll 2
-        for (int e = 1; e < Dim; ++e) {
-          change += dv[e][lane] * dv[e][lane];
-          before += v_flip[e] * v_flip[e];
-          after += v_new[e] * v_new[e];
-        }
+        const double change = sum_of_squares<Dim>([&](int e) { return dv[e][lane]; }),
+                     before = sum_of_squares<Dim>([&](int e) { return v_flip[e]; }),
+                     after = sum_of_squares<Dim>([&](int e) { return v_new[e]; });
         gain[lane] = 0.5 * m * spread[lane];
         loss[lane] = 0.5 * m * (spread[lane] - change);
         if constexpr (Apic) loss[lane] += m * affine[lane];
@@ -972,7 +989,7 @@ void Solver<Dim>::gather_motion(double dt) {
       lost += loss[lane];
       lost += blend[lane];
     }
-    if constexpr (Move) count<Width>(start, lanes, dt, census);
+    if constexpr (Move) count(start, lanes, dt, census);
   };
   if constexpr (Apic) {
 #pragma omp parallel reduction(merge : census) reduction(+ : lost, work, gained)
@@ -1087,14 +1104,14 @@ void Solver<Dim>::step_kernel(double dt) {
 template <int Dim>
 Census Solver<Dim>::move_particles(double dt) {
   auto& p = particles_;
-  constexpr int width = 16;
+  constexpr int width = chunk_lanes;
   const int n = static_cast<int>(p.size()), chunks = (n + width - 1) / width;
   Census census;
 #pragma omp parallel for schedule(static) reduction(merge : census)
   for (int c = 0; c < chunks; ++c) {
     const int start = c * width, end = std::min(n, start + width);
     for (int i = start; i < end; ++i) p.x[i] += displacement_[i];
-    count<width>(start, end - start, dt, census);
+    count(start, end - start, dt, census);
   }
   return census;
 }

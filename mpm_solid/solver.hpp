@@ -335,7 +335,7 @@ class Solver {
   template <class F>
   void over_layer(int axis, int row, F&& f) const;
   void update_stresses(double dt);
-  template <int Width>
+  // At most chunk_lanes particles.
   void count(int start, int lanes, double dt, Census& census) const;
   Census move_particles(double dt);
   void remove_escaped(const Census& census, StepInfo& info);

@@ -88,7 +88,11 @@ struct Stencil {
 // order (either gives the same bits). Nothing per node is stored and read
 // back, and the gathers' node loops run over the lanes, for the compiler to
 // vectorise (README.md, The MPM solver, has what it gained).
-template <int Dim, class Shape, int Width = 16>
+// Particles per chunk of the passes over SIMD lanes: several vectors' worth,
+// and few enough that a chunk's stencils and sums stay in L1.
+inline constexpr int chunk_lanes = 16;
+
+template <int Dim, class Shape, int Width = chunk_lanes>
 struct StencilLanes {
   static constexpr int support = Shape::support;
   static constexpr int count = Stencil<Dim, Shape>::count;
