@@ -62,22 +62,38 @@ template <>
 struct Principal<3> {
   Mat<3> matrix;
   Vec<3> values;  // ascending
-  Mat<3> axes;    // the columns; only where the values straddle zero
-  explicit Principal(const Mat<3>& s) : matrix(s) {
+  Mat<3> axes = Mat<3>::Zero();  // the columns; only where the values straddle zero
+  // The closed form's values alone: accurate for them, less so for the axes
+  // of nearly equal ones.
+  struct ValuesOnly {};
+  Principal(const Mat<3>& s, ValuesOnly) : matrix(s) {
+    Eigen::SelfAdjointEigenSolver<Mat<3>> solver;
+    solver.computeDirect(s, Eigen::EigenvaluesOnly);
+    values = solver.eigenvalues();
+  }
+  explicit Principal(const Mat<3>& s) : Principal(s, ValuesOnly{}) { find_axes(); }
+  // What cracked() needs of a decomposition made ValuesOnly.
+  Principal with_axes() const {
+    Principal full = *this;
+    full.find_axes();
+    return full;
+  }
+
+ private:
+  void find_axes() {
     // A state all in tension, or all in compression, cracks without its
     // axes. Where they are needed, the iterative solver's: the closed form's
     // are not orthogonal where two principal values agree (by 7e-7 under
     // uniaxial strain, its two lateral stresses equal), and the stress
     // recomposed from them is off by as much.
-    Eigen::SelfAdjointEigenSolver<Mat<3>> solver;
-    solver.computeDirect(s, Eigen::EigenvaluesOnly);
-    values = solver.eigenvalues();
     if (values[0] < 0 && values[2] > 0) {
-      solver.compute(s);
+      Eigen::SelfAdjointEigenSolver<Mat<3>> solver(matrix);
       values = solver.eigenvalues();
       axes = solver.eigenvectors();
     }
   }
+
+ public:
   Mat<3> cracked(double factor) const {
     if (values[0] >= 0) return factor * matrix;
     if (values[2] <= 0) return matrix;
@@ -175,6 +191,10 @@ void ElasticDamage<Dim>::create_fields(Particles<Dim>& p, const std::vector<int>
 
 template <int Dim>
 struct ElasticDamage<Dim>::Stresses {
+  // Of the in-plane (or whole) matrix, made once for the damage law and
+  // the acting stress (in 3D, without its axes; settle finds them where it
+  // needs them).
+  Principal<Dim> principal;
   double s1, s2, s3;    // s1 >= s2 >= s3, out-of-plane included
   double eps1, eps3;    // the strains along s1 and s3
 };
@@ -190,16 +210,14 @@ typename ElasticDamage<Dim>::Stresses ElasticDamage<Dim>::principal_stresses(con
     s1 = std::max(pr.largest(), effective_zz);
     s3 = std::min(pr.smallest(), effective_zz);
     s2 = pr.sum() + effective_zz - s1 - s3;
+    return {pr, s1, s2, s3, (s1 - nu * (s2 + s3)) / e0, (s3 - nu * (s1 + s2)) / e0};
   } else {
-    // The values alone: the closed form is accurate for them, less so for
-    // the axes of nearly equal ones.
-    Eigen::SelfAdjointEigenSolver<Mat<3>> solver;
-    solver.computeDirect(effective, Eigen::EigenvaluesOnly);
-    s1 = solver.eigenvalues()[2];
-    s2 = solver.eigenvalues()[1];
-    s3 = solver.eigenvalues()[0];
+    const Principal<3> pr(effective, Principal<3>::ValuesOnly{});
+    s1 = pr.values[2];
+    s2 = pr.values[1];
+    s3 = pr.values[0];
+    return {pr, s1, s2, s3, (s1 - nu * (s2 + s3)) / e0, (s3 - nu * (s1 + s2)) / e0};
   }
-  return {s1, s2, s3, (s1 - nu * (s2 + s3)) / e0, (s3 - nu * (s1 + s2)) / e0};
 }
 
 template <int Dim>
@@ -212,9 +230,13 @@ double ElasticDamage<Dim>::shear_damage(const Stresses& s, double scale, double 
 template <int Dim>
 double ElasticDamage<Dim>::damage(double previous, const Mat<Dim>& effective, double effective_zz, double scale,
                                   double stiffness) const {
+  return damage(previous, principal_stresses(effective, effective_zz, stiffness), scale, stiffness);
+}
+
+template <int Dim>
+double ElasticDamage<Dim>::damage(double previous, const Stresses& st, double scale, double stiffness) const {
   const auto& d = parameters_;
   const double e0 = stiffness * this->elasticity().youngs_modulus;
-  const Stresses st = principal_stresses(effective, effective_zz, stiffness);
   const double s1 = st.s1, eps1 = st.eps1;
   double damage = previous;
   if (s1 >= scale * d.tensile_strength) {
@@ -279,7 +301,7 @@ void ElasticDamage<Dim>::trial(Particles<Dim>& p, std::span<const int> members, 
 // The acting stress at damage d, what the growth of damage took, and the
 // friction of compressive states.
 template <int Dim>
-Dissipation ElasticDamage<Dim>::settle(Particles<Dim>& p, int i, double d) const {
+Dissipation ElasticDamage<Dim>::settle(Particles<Dim>& p, int i, double d, const Stresses& st) const {
   const double stiffness = modulus_scale(p, i);
   const double g = stiffness * this->shear_modulus();
   const double bulk = stiffness * this->lame_lambda() + 2.0 / 3.0 * g;
@@ -294,7 +316,10 @@ Dissipation ElasticDamage<Dim>::settle(Particles<Dim>& p, int i, double d) const
   // decomposition and recomposition would move it by roundoff every step.
   const bool intact = Dim == 3 && d == 0;
   std::optional<Principal<Dim>> pr;
-  if (!intact) pr.emplace(effective);
+  if constexpr (Dim == 2)
+    pr.emplace(st.principal);
+  else if (!intact)
+    pr.emplace(st.principal.with_axes());
   Mat<Dim> s = intact ? effective : pr->cracked(1 - d);
   double s_zz = crack(effective_zz, 1 - d);
   if (d > previous) {
@@ -338,8 +363,9 @@ Dissipation ElasticDamage<Dim>::update_chunk(Particles<Dim>& p, std::span<const 
   if (!pointwise()) throw std::logic_error("nonlocal damage updates a material's particles together (update_stress)");
   trial(p, members, dt);
   return each_member(members, [&](int i) {
-    const double zz = Dim == 2 ? p.effective_stress_zz[i] : 0.0;
-    return settle(p, i, damage(p.damage[i], p.effective_stress[i], zz, strength_scale(p, i), modulus_scale(p, i)));
+    const double zz = Dim == 2 ? p.effective_stress_zz[i] : 0.0, stiffness = modulus_scale(p, i);
+    const Stresses st = principal_stresses(p.effective_stress[i], zz, stiffness);
+    return settle(p, i, damage(p.damage[i], st, strength_scale(p, i), stiffness), st);
   });
 }
 
@@ -374,7 +400,7 @@ Dissipation ElasticDamage<Dim>::update_stress(Particles<Dim>& p, const std::vect
     const double d = std::clamp(std::max({p.damage[i], nonlocal_tensile_damage(averaged[k]),
                                           shear_damage(st, strength_scale(p, i), stiffness)}),
                                 0.0, 1.0);
-    const Dissipation r = settle(p, i, d);
+    const Dissipation r = settle(p, i, d, st);
     plastic += r.plastic;
     damaged += r.damage;
   }

@@ -132,11 +132,14 @@ class ElasticDamage final : public Material<Dim> {
   // The step's kinematics and the elastic trial of the members' undamaged
   // stresses over dt.
   void trial(Particles<Dim>& p, std::span<const int> members, double dt) const;
-  // Sets particle i's damage to d (no less than it had) and its acting
-  // stress, and returns what that dissipated.
-  Dissipation settle(Particles<Dim>& p, int i, double d) const;
-  struct Stresses;  // ordered principal stresses, with the strains they hold
+  // Ordered principal stresses, with the strains they hold, and the
+  // decomposition of the effective stress they came from.
+  struct Stresses;
   Stresses principal_stresses(const Mat<Dim>& effective, double effective_zz, double stiffness) const;
+  // Sets particle i's damage to d (no less than it had) and its acting
+  // stress, and returns what that dissipated; st is its effective stress's.
+  Dissipation settle(Particles<Dim>& p, int i, double d, const Stresses& st) const;
+  double damage(double previous, const Stresses& st, double scale, double stiffness) const;
   double shear_damage(const Stresses& s, double scale, double stiffness) const;
   // The local driver of nonlocal damage: eps_1 over the strain at f_t, in
   // [0, eta].
