@@ -53,9 +53,11 @@ struct Gimp {
   static constexpr int support = 3;
   static constexpr const char* name = "gimp";
   static inline int eval(double xi, double lp, double* w, double* dw) {
-    const int base = floor_int(xi - 1 - lp) + 1;
+    // Unsigned, and the nodes' places in double: floor_int wraps to int's
+    // highest far below the grid, and one more would overflow.
+    const int base = static_cast<int>(static_cast<unsigned>(floor_int(xi - 1 - lp)) + 1u);
     for (int k = 0; k < 3; ++k) {
-      const double r = xi - (base + k);
+      const double r = xi - (static_cast<double>(base) + k);
       const double a = std::abs(r);
       const double s = r < 0 ? -1.0 : 1.0;
       if (a < lp) {
