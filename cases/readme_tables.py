@@ -467,6 +467,9 @@ block("mpm benchmark fused linear", "mpm_solid/benchmark/compare-63e0ffd-78f1b01
 block("mpm benchmark motion lanes", "mpm_solid/benchmark/compare-63e0ffd-e79aca1-aa69a3e.csv")(mpm_benchmark_builds)
 block("mpm benchmark 3d motion lanes", "mpm_solid/benchmark/compare-3d-e79aca1-aa69a3e.csv")(mpm_benchmark_builds)
 block("outburst cost motion lanes", "cases/outburst/benchmark/outburst-benchmark-motion-lanes.csv")(outburst_cost)
+block("mpm benchmark census lanes", "mpm_solid/benchmark/compare-63e0ffd-a49a143-e7788a0.csv")(mpm_benchmark_builds)
+block("mpm benchmark 3d census lanes", "mpm_solid/benchmark/compare-3d-a49a143-e7788a0.csv")(mpm_benchmark_builds)
+block("outburst cost census lanes", "cases/outburst/benchmark/outburst-benchmark-census-lanes.csv")(outburst_cost)
 
 
 @block("mpm benchmark", "mpm_solid/benchmark/mpm-benchmark.csv")
