@@ -208,8 +208,8 @@ std::vector<double> p_moduli(const std::vector<std::unique_ptr<Material<Dim>>>& 
 }
 
 // v . v of a Dim-vector, summed left to right as Eigen's squaredNorm() does,
-// entry(e) its e-th entry: one order for the lanes' loops and the per-particle
-// checks after them, so that they agree to the bit.
+// entry(e) its e-th entry: one order for every loop over lanes that sums
+// squares (the signal and runaway speeds, the energy books).
 template <int Dim, class Entry>
 [[gnu::always_inline]] inline double sum_of_squares(Entry entry) {
   double sum = entry(0) * entry(0);
@@ -218,22 +218,48 @@ template <int Dim, class Entry>
   return sum;
 }
 
-// The fastest signal at particle i: its P wave, which speeds up as the
-// material compresses (density rises) and with a heterogeneous material's
-// draw of the moduli (Drawn: scale holds the draws), plus its own speed,
-// whose square is given. Two divisions and two square roots: the loops that
-// call it run over SIMD lanes, which one particle at a time held the motion
-// gather on the divider for a fifth of its time (perf, linear elastic). One
-// function for the stable step's pass and the move's census, so the two
-// agree to the bit.
-template <bool Drawn, int Dim>
-[[gnu::always_inline]] inline double signal_speed(const double* p_modulus, const double* scale,
-                                                  const Particles<Dim>& p, std::ptrdiff_t i, double speed_squared) {
-  const double density = p.mass[i] / p.volume[i];
-  double stiffness = p_modulus[p.material[i]];
-  if constexpr (Drawn) stiffness *= scale[i];
-  return std::sqrt(stiffness / density) + std::sqrt(speed_squared);
-}
+// What a particle's signal and runaway speeds read, by local pointers: read
+// through the particles' vectors inside a loop over lanes, the vectors' ends
+// were loaded again after every store, and GCC ran the loop's scalar copy
+// (the census, a third of the motion gather). Drawn: whether scale holds a
+// heterogeneous material's draws of the moduli (with_draws below).
+struct Speeds {
+  const double *p_modulus, *wave_squared, *mass, *volume, *scale;
+  const int* material;
+
+  template <int Dim>
+  Speeds(const std::vector<double>& p_modulus, const std::vector<double>& wave_squared, const Particles<Dim>& p)
+      : p_modulus(p_modulus.data()),
+        wave_squared(wave_squared.data()),
+        mass(p.mass.data()),
+        volume(p.volume.data()),
+        scale(p.modulus_scale.data()),
+        material(p.material.data()) {}
+
+  // The fastest signal at particle i: its P wave, which speeds up as the
+  // material compresses (density rises) and with the draw of the moduli,
+  // plus its own speed, whose square is given. Two divisions and two square
+  // roots, which one particle at a time held the motion gather on the
+  // divider for a fifth of its time (perf, linear elastic). One function for
+  // the stable step's pass and the move's census, so the two agree.
+  template <bool Drawn>
+  [[gnu::always_inline]] double signal(std::ptrdiff_t i, double speed_squared) const {
+    const double density = mass[i] / volume[i];
+    double stiffness = p_modulus[material[i]];
+    if constexpr (Drawn) stiffness *= scale[i];
+    return std::sqrt(stiffness / density) + std::sqrt(speed_squared);
+  }
+
+  // The square of the speed beyond which particle i's energy is exploding:
+  // its material's P wave. A stiff draw carries a faster wave; a soft one is
+  // still stepped at the stiffest particle's step, so it is held to its
+  // material's speed.
+  template <bool Drawn>
+  [[gnu::always_inline]] double runaway_squared(std::ptrdiff_t i) const {
+    const double limit = wave_squared[material[i]];
+    return Drawn ? std::max(1.0, scale[i]) * limit : limit;
+  }
+};
 
 // f(std::bool_constant<Drawn>{}), Drawn whether the particles carry a
 // heterogeneous material's draws of the moduli: the lanes' loops are
@@ -383,16 +409,17 @@ void Solver<Dim>::rebuild_material_groups() { members_ = material_members(partic
 template <int Dim>
 double stable_time_step(const std::vector<std::unique_ptr<Material<Dim>>>& materials,
                         const Particles<Dim>& particles, double h, double courant) {
-  const std::vector<double> p_modulus = p_moduli(materials);
-  const double *modulus = p_modulus.data(), *scale = particles.modulus_scale.data(),
-               *velocity = particles.v.data()->data();
   const std::ptrdiff_t n = static_cast<std::ptrdiff_t>(particles.size());
   double fastest = 0;
+  if (n == 0) return courant * h / fastest;
+  const std::vector<double> p_modulus = p_moduli(materials);
+  const Speeds speeds(p_modulus, {}, particles);
+  const double* velocity = particles.v.data()->data();
   with_draws(particles, [&](auto drawn) {
 #pragma omp parallel for simd schedule(static) reduction(max : fastest)
     for (std::ptrdiff_t i = 0; i < n; ++i) {
       const double squared = sum_of_squares<Dim>([&](int e) { return velocity[Dim * i + e]; });
-      fastest = std::max(fastest, signal_speed<decltype(drawn)::value>(modulus, scale, particles, i, squared));
+      fastest = std::max(fastest, speeds.signal<decltype(drawn)::value>(i, squared));
     }
   });
   return courant * h / fastest;
@@ -819,11 +846,8 @@ double Solver<Dim>::apply_walls(std::vector<Vec<Dim>>& velocity) const {
 
 template <int Dim>
 [[gnu::always_inline]] inline double Solver<Dim>::runaway_speed_squared(int i) const {
-  // A stiff draw of a heterogeneous material carries a faster wave; a soft one
-  // is still stepped at the stiffest particle's step, so it is held to its
-  // material's speed.
-  const double stiffness = particles_.modulus_scale.empty() ? 1.0 : std::max(1.0, particles_.modulus_scale[i]);
-  return stiffness * wave_speed_squared_[particles_.material[i]];
+  const Speeds speeds(p_modulus_, wave_speed_squared_, particles_);
+  return particles_.modulus_scale.empty() ? speeds.runaway_squared<false>(i) : speeds.runaway_squared<true>(i);
 }
 
 // Whether every entry is finite. Eigen's allFinite() compares x - x with
@@ -852,13 +876,11 @@ template <int Dim>
   alignas(64) double pore_work[most];
   long bad = 0, escaped = 0, runaway = 0;
   double fastest = census.fastest;
-  // Locals: read through the particles inside the loop, the vectors' ends
-  // would be loaded again for every lane, and the loop was left scalar.
+  // Locals, as Speeds holds its fields.
   const double *x = p.x.data()->data(), *v = p.v.data()->data(), *stress = p.stress.data()->data(),
                *gradient = p.velocity_gradient.data()->data(), *pore_pressure = p.pore_pressure.data(),
-               *volume = p.volume.data(), *modulus = p_modulus_.data(), *scale = p.modulus_scale.data(),
-               *wave = wave_speed_squared_.data();
-  const int* material = p.material.data();
+               *volume = p.volume.data();
+  const Speeds speeds(p_modulus_, wave_speed_squared_, p);
   const Vec<Dim> lower = grid_.lower, upper = grid_.upper;
   const auto over_lanes = [&](auto pore, auto drawn) __attribute__((always_inline)) {
 #pragma omp simd reduction(+ : bad, escaped, runaway) reduction(max : fastest)
@@ -881,15 +903,13 @@ template <int Dim>
 #pragma GCC unroll 9
       for (int e = 0; e < Dim * Dim; ++e) finite &= std::isfinite(stress[Dim * Dim * i + e]);
       const double squared = sum_of_squares<Dim>([&](int e) { return v[Dim * i + e]; });
-      // runaway_speed_squared(i), its draw's test taken out of the loop.
-      double limit = wave[material[i]];
-      if constexpr (decltype(drawn)::value) limit = std::max(1.0, scale[i]) * limit;
-      const bool fast = squared > limit;
+      const bool fast = squared > speeds.runaway_squared<decltype(drawn)::value>(i);
       bad += !finite;
       escaped += finite & !inside;
       runaway += finite & inside & fast;
-      const double speed = signal_speed<decltype(drawn)::value>(modulus, scale, p, i, squared);
-      // A NaN speed (a particle of no volume) is passed over, as std::max does.
+      const double speed = speeds.signal<decltype(drawn)::value>(i, squared);
+      // A NaN speed (a particle turned inside out: negative volume) is
+      // passed over, as std::max passed it over.
       if (finite & inside & !fast & (speed > fastest)) fastest = speed;
     }
   };
@@ -931,6 +951,7 @@ void Solver<Dim>::gather_motion(double dt) {
                                      const double(&dv)[Dim][Width], const double(&spread)[Width],
                                      const double* affine, Census& census, double& lost, double& work,
                                      double& gained) __attribute__((always_inline)) {
+    static_assert(Width <= chunk_lanes, "count() books at most chunk_lanes particles");
     alignas(64) double gain[Width], loss[Width], blend[Width], load_work[Width];
     double *x = p.x.data()->data(), *v = p.v.data()->data(), *displacement = Move ? nullptr : displacement_.data()->data();
     const auto over_lanes = [&](auto loaded) __attribute__((always_inline)) {

@@ -82,16 +82,16 @@ struct Stencil {
   }
 };
 
+// Particles per chunk of the passes over SIMD lanes: several vectors' worth,
+// and few enough that a chunk's stencils and sums stay in L1.
+inline constexpr int chunk_lanes = 16;
+
 // The stencils of a chunk of up to Width particles, one lane per particle:
 // each direction's 1D weights, from which a node's weight and gradient are
 // formed where a pass uses them, with Stencil::compute's products in its
 // order (either gives the same bits). Nothing per node is stored and read
 // back, and the gathers' node loops run over the lanes, for the compiler to
 // vectorise (README.md, The MPM solver, has what it gained).
-// Particles per chunk of the passes over SIMD lanes: several vectors' worth,
-// and few enough that a chunk's stencils and sums stay in L1.
-inline constexpr int chunk_lanes = 16;
-
 template <int Dim, class Shape, int Width = chunk_lanes>
 struct StencilLanes {
   static constexpr int support = Shape::support;

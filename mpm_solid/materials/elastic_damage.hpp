@@ -132,12 +132,13 @@ class ElasticDamage final : public Material<Dim> {
   // The step's kinematics and the elastic trial of the members' undamaged
   // stresses over dt.
   void trial(Particles<Dim>& p, std::span<const int> members, double dt) const;
-  // Ordered principal stresses, with the strains they hold, and the
-  // decomposition of the effective stress they came from.
+  // Ordered principal stresses, with the strains they hold, and in the
+  // plane the decomposition of the effective stress they came from.
   struct Stresses;
   Stresses principal_stresses(const Mat<Dim>& effective, double effective_zz, double stiffness) const;
   // Sets particle i's damage to d (no less than it had) and its acting
-  // stress, and returns what that dissipated; st is its effective stress's.
+  // stress, and returns what that dissipated; in the plane it reads the
+  // decomposition in st, its effective stress's.
   Dissipation settle(Particles<Dim>& p, int i, double d, const Stresses& st) const;
   double damage(double previous, const Stresses& st, double scale, double stiffness) const;
   double shear_damage(const Stresses& s, double scale, double stiffness) const;
