@@ -227,10 +227,11 @@ struct Speeds {
   const double *p_modulus, *wave_squared, *mass, *volume, *scale;
   const int* material;
 
+  // wave_squared: per material, or null where no runaway is checked.
   template <int Dim>
-  Speeds(const std::vector<double>& p_modulus, const std::vector<double>& wave_squared, const Particles<Dim>& p)
+  Speeds(const std::vector<double>& p_modulus, const double* wave_squared, const Particles<Dim>& p)
       : p_modulus(p_modulus.data()),
-        wave_squared(wave_squared.data()),
+        wave_squared(wave_squared),
         mass(p.mass.data()),
         volume(p.volume.data()),
         scale(p.modulus_scale.data()),
@@ -413,7 +414,7 @@ double stable_time_step(const std::vector<std::unique_ptr<Material<Dim>>>& mater
   double fastest = 0;
   if (n == 0) return courant * h / fastest;
   const std::vector<double> p_modulus = p_moduli(materials);
-  const Speeds speeds(p_modulus, {}, particles);
+  const Speeds speeds(p_modulus, nullptr, particles);
   const double* velocity = particles.v.data()->data();
   with_draws(particles, [&](auto drawn) {
 #pragma omp parallel for simd schedule(static) reduction(max : fastest)
@@ -846,7 +847,7 @@ double Solver<Dim>::apply_walls(std::vector<Vec<Dim>>& velocity) const {
 
 template <int Dim>
 [[gnu::always_inline]] inline double Solver<Dim>::runaway_speed_squared(int i) const {
-  const Speeds speeds(p_modulus_, wave_speed_squared_, particles_);
+  const Speeds speeds(p_modulus_, wave_speed_squared_.data(), particles_);
   return particles_.modulus_scale.empty() ? speeds.runaway_squared<false>(i) : speeds.runaway_squared<true>(i);
 }
 
@@ -880,7 +881,7 @@ template <int Dim>
   const double *x = p.x.data()->data(), *v = p.v.data()->data(), *stress = p.stress.data()->data(),
                *gradient = p.velocity_gradient.data()->data(), *pore_pressure = p.pore_pressure.data(),
                *volume = p.volume.data();
-  const Speeds speeds(p_modulus_, wave_speed_squared_, p);
+  const Speeds speeds(p_modulus_, wave_speed_squared_.data(), p);
   const Vec<Dim> lower = grid_.lower, upper = grid_.upper;
   const auto over_lanes = [&](auto pore, auto drawn) __attribute__((always_inline)) {
 #pragma omp simd reduction(+ : bad, escaped, runaway) reduction(max : fastest)
