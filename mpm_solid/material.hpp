@@ -262,10 +262,19 @@ template <int Dim, class Index, class Stiffness>
   }
 }
 
+// f(index), index(k) the particle of a chunk's k-th member (none empty):
+// consecutive members (every material, unless bodies of two interleave) by
+// position, so that SIMD lanes load them as a block, the rest from the list.
+template <class F>
+[[gnu::always_inline]] inline decltype(auto) by_position(std::span<const int> members, F&& f) {
+  const int first = members.front();
+  if (members.back() - first == static_cast<int>(members.size()) - 1) return f([first](int k) { return first + k; });
+  return f([members](int k) { return members[static_cast<std::size_t>(k)]; });
+}
+
 // The same over a chunk of a material's members, in increasing order, none
 // twice (as material_members lists them): the lanes write each its own
-// particle, and consecutive members (every material, unless bodies of two
-// interleave) run as a block, reached by position.
+// particle.
 template <int Dim>
 void deform_and_trial(Particles<Dim>& p, std::span<const int> members, double dt, double lambda, double shear,
                       const std::vector<double>* stiffness, std::vector<Mat<Dim>>& stress,
@@ -274,17 +283,13 @@ void deform_and_trial(Particles<Dim>& p, std::span<const int> members, double dt
   if (members.empty()) return;
   const int n = static_cast<int>(members.size());
   double* zz = Dim == 2 ? stress_zz.data() : nullptr;
-  const auto with = [&](auto index) {
+  by_position(members, [&](auto index) {
     if (stiffness)
       deform_and_trial(p, n, index, [scale = stiffness->data()](std::ptrdiff_t i) { return scale[i]; }, dt, lambda,
                        shear, stress.data(), zz);
     else
       deform_and_trial(p, n, index, [](std::ptrdiff_t) { return 1.0; }, dt, lambda, shear, stress.data(), zz);
-  };
-  if (const int first = members.front(); members.back() - first == n - 1)
-    with([first](int k) { return first + k; });
-  else
-    with([members](int k) { return members[static_cast<std::size_t>(k)]; });
+  });
 }
 
 // Mean stress and deviator (plane strain: zz included in both).

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <numeric>
 #include <set>
 
 #include "mpm_solid/materials/drucker_prager.hpp"
@@ -229,6 +230,87 @@ TEST_CASE("elastic-damage: broken coal bulks to its bulking factor and no furthe
   drive(m, p, l, 100, 1.0 / 100);  // fragments parting: the deformation says 2.7 x the volume
   CHECK(p.deformation[0].determinant() > 2.5);
   CHECK(p.volume[0] == Approx(coal_damage.bulking_factor * p.volume0[0]).epsilon(1e-12));
+}
+
+TEST_CASE("elastic-damage: a chunk settled over SIMD lanes ends as each of its particles settled alone",
+          "[mpm][material][damage]") {
+  // 64 particles (a whole chunk) strained along their own paths through
+  // every branch of the update: intact, equal principal stresses (no axes),
+  // tensile damage growing and full, crushing, friction on the cone, and
+  // unloading. Updated together, the lanes run vector code and pick the
+  // particles that need settle's scalar path; updated one at a time, the
+  // same code runs on a single lane. The two must agree to the bit, but for
+  // the acting stress, which the compiler's fused multiply-adds (placed
+  // apart in vector and scalar code) may move by an ulp.
+  const auto run = [](const DamageParameters& d) {
+    ElasticDamage<2> m("coal", coal, d);
+    const int n = chunk_size;
+    Particles<2> together;
+    for (int k = 0; k < n; ++k) together.add({0.1 * k, 0}, {0, 0}, 1, 1, 0.25, Mat<2>::Zero(), 0, 0);
+    std::vector<int> members(n);
+    std::iota(members.begin(), members.end(), 0);
+    m.create_fields(together, members);
+    std::vector<Mat<2>> l(n);
+    for (int k = 0; k < n; ++k) {
+      // Eight amplitudes: strains from 2e-5 to 3.5e-4 along each direction.
+      const double size = 0.05 + (k % 8) / 8.0, angle = 0.7 * k;
+      const double a = size * std::sin(1.3 * k), b = size * std::cos(2.1 * k), spin = 0.2 * std::sin(0.5 * k);
+      Mat<2> r;
+      r << std::cos(angle), -std::sin(angle), std::sin(angle), std::cos(angle);
+      l[k] = r * Vec<2>(a, b).asDiagonal() * r.transpose();
+      l[k](0, 1) -= spin, l[k](1, 0) += spin;
+    }
+    l[0].setZero();                // never loaded: principal values equal
+    l[1] = Mat<2>::Identity();     // spreading equally: in tension, no axes
+    l[2] = -Mat<2>::Identity();    // squeezed equally
+    Particles<2> alone = together;
+    Dissipation in_chunk, one_by_one;
+    // Out to strains of 4e-4 (full damage at 1.7e-4 in tension), then back by a quarter.
+    for (const double sign : {1.0, 1.0, -0.5}) {
+      for (int k = 0; k < n; ++k) together.velocity_gradient[k] = alone.velocity_gradient[k] = sign * l[k];
+      for (int s = 0; s < 100; ++s) {
+        in_chunk += m.update_stress(together, members, 2e-6);
+        for (int k = 0; k < n; ++k) one_by_one += m.update_stress(alone, {k}, 2e-6);
+      }
+    }
+    int damaged = 0, broken = 0, sliding = 0;
+    for (int k = 0; k < n; ++k) {
+      CAPTURE(k);
+      CHECK((together.stress[k] - alone.stress[k]).norm() <= 1e-15 * alone.stress[k].norm());
+      CHECK(together.stress_zz[k] == alone.stress_zz[k]);
+      CHECK(together.effective_stress[k] == alone.effective_stress[k]);
+      CHECK(together.damage[k] == alone.damage[k]);
+      CHECK(together.plastic_strain[k] == alone.plastic_strain[k]);
+      CHECK(together.volume[k] == alone.volume[k]);
+      // Settle's friction, whichever path took the particle: a compressive
+      // state within the cone of the cohesion its damage leaves.
+      const double scale = d.heterogeneity ? together.strength_scale[k] : 1.0;
+      const DruckerPrager<2> left("left", coal, (1 - together.damage[k]) * scale * d.cohesion,
+                                  d.friction_angle, 0.0, DruckerPragerFit::Kind::outer);
+      if (together.stress[k].trace() + together.stress_zz[k] < 0)
+        CHECK(left.yield(together.stress[k], together.stress_zz[k]) <= 1e-9 * d.cohesion);
+      damaged += together.damage[k] > 0 && together.damage[k] < 1;
+      broken += together.damage[k] == 1;
+      sliding += together.plastic_strain[k] > 0;
+    }
+    // The paths reach every branch they are meant to.
+    CHECK(damaged > 0);
+    CHECK(broken > 0);
+    CHECK(sliding > 0);
+    CHECK(together.damage[0] == 0);
+    CHECK(together.damage[1] == 1);
+    CHECK(together.damage[2] == 0);
+    CHECK(in_chunk.damage == Approx(one_by_one.damage).epsilon(1e-12));
+    CHECK(in_chunk.plastic == Approx(one_by_one.plastic).epsilon(1e-12));
+  };
+  SECTION("the paper's law") { run(coal_damage); }
+  SECTION("heterogeneous coal under a crack band") {
+    DamageParameters d = coal_damage;
+    d.fracture_energy = 2.4;
+    d.band_width = 0.5;
+    d.heterogeneity = DamageParameters::Heterogeneity{3.0, 7};
+    run(d);
+  }
 }
 
 // Kolmogorov-Smirnov distance of draws u (sorted in place) to the Weibull law

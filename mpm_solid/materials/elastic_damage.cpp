@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <array>
+#include <cassert>
+#include <cstddef>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -32,31 +34,42 @@ struct Principal;
 
 template <>
 struct Principal<2> {
-  double a, b;       // a >= b
-  Vec<2> direction;  // of a
-  explicit Principal(const Mat<2>& s) {
-    const double centre = 0.5 * (s(0, 0) + s(1, 1));
-    const double half = 0.5 * (s(0, 0) - s(1, 1));
-    const double radius = std::sqrt(half * half + s(0, 1) * s(0, 1));
-    if (radius == 0) {
-      a = b = centre;
-      direction = Vec<2>(1, 0);
-      return;
-    }
+  double a, b;          // a >= b
+  double cos, sin;      // the direction of a
+  // Straight-line code, both cases computed and one chosen, as are the
+  // damage law's: the plane's update runs them over SIMD lanes.
+  Principal(double xx, double yy, double xy) {
+    const double centre = 0.5 * (xx + yy);
+    const double half = 0.5 * (xx - yy);
+    const double radius = std::sqrt(half * half + xy * xy);
     // Half-angle formulas from cos 2t = half / radius, sin 2t = s_xy / radius:
     // no trigonometric calls in the innermost loop of the damage law.
     const double cos2 = half / radius;
-    const double c = std::sqrt(0.5 * (1 + cos2)), sn = std::copysign(std::sqrt(0.5 * (1 - cos2)), s(0, 1));
-    a = centre + radius;
-    b = centre - radius;
-    direction = Vec<2>(c, sn);
+    const bool equal = radius == 0;  // any direction is principal
+    a = equal ? centre : centre + radius;
+    b = equal ? centre : centre - radius;
+    const double c = std::sqrt(0.5 * (1 + cos2)), s = std::copysign(std::sqrt(0.5 * (1 - cos2)), xy);
+    cos = equal ? 1.0 : c;
+    sin = equal ? 0.0 : s;
   }
+  explicit Principal(const Mat<2>& s) : Principal(s(0, 0), s(1, 1), s(0, 1)) {}
   double largest() const { return a; }
   double smallest() const { return b; }
   double sum() const { return a + b; }
+  // The entries in Eigen's column-major order, each as Eigen formed
+  // (crack(a) direction) direction^T + (crack(b) normal) normal^T.
+  void cracked(double factor, double* out) const {
+    const double ca = crack(a, factor), cb = crack(b, factor), nx = -sin, ny = cos;
+    const double t0 = ca * cos, t1 = ca * sin, u0 = cb * nx, u1 = cb * ny;
+    out[0] = t0 * cos + u0 * nx;
+    out[1] = t1 * cos + u1 * nx;
+    out[2] = t0 * sin + u0 * ny;
+    out[3] = t1 * sin + u1 * ny;
+  }
   Mat<2> cracked(double factor) const {
-    const Vec<2> normal(-direction.y(), direction.x());
-    return crack(a, factor) * direction * direction.transpose() + crack(b, factor) * normal * normal.transpose();
+    Mat<2> m;
+    cracked(factor, m.data());
+    return m;
   }
 };
 
@@ -188,34 +201,41 @@ struct ElasticDamage<Dim>::Stresses {
 };
 
 template <int Dim>
+template <class Plane>
+[[gnu::always_inline]] inline typename ElasticDamage<Dim>::Stresses ElasticDamage<Dim>::plane_stresses(
+    const Plane& pr, double effective_zz, double stiffness) const {
+  const double e0 = stiffness * this->elasticity().youngs_modulus, nu = this->elasticity().poisson_ratio;
+  const double s1 = std::max(pr.largest(), effective_zz), s3 = std::min(pr.smallest(), effective_zz);
+  const double s2 = pr.sum() + effective_zz - s1 - s3;
+  return {pr, s1, s2, s3, (s1 - nu * (s2 + s3)) / e0, (s3 - nu * (s1 + s2)) / e0};
+}
+
+template <int Dim>
 typename ElasticDamage<Dim>::Stresses ElasticDamage<Dim>::principal_stresses(const Mat<Dim>& effective,
                                                                              double effective_zz,
                                                                              double stiffness) const {
-  const double e0 = stiffness * this->elasticity().youngs_modulus, nu = this->elasticity().poisson_ratio;
-  double s1, s2, s3;
   if constexpr (Dim == 2) {
-    const Principal<Dim> pr(effective);
-    s1 = std::max(pr.largest(), effective_zz);
-    s3 = std::min(pr.smallest(), effective_zz);
-    s2 = pr.sum() + effective_zz - s1 - s3;
-    return {pr, s1, s2, s3, (s1 - nu * (s2 + s3)) / e0, (s3 - nu * (s1 + s2)) / e0};
+    return plane_stresses(Principal<2>(effective), effective_zz, stiffness);
   } else {
     // The values alone: the closed form is accurate for them, less so for
     // the axes of nearly equal ones.
+    const double e0 = stiffness * this->elasticity().youngs_modulus, nu = this->elasticity().poisson_ratio;
     Eigen::SelfAdjointEigenSolver<Mat<3>> solver;
     solver.computeDirect(effective, Eigen::EigenvaluesOnly);
-    s1 = solver.eigenvalues()[2];
-    s2 = solver.eigenvalues()[1];
-    s3 = solver.eigenvalues()[0];
+    const double s1 = solver.eigenvalues()[2], s2 = solver.eigenvalues()[1], s3 = solver.eigenvalues()[0];
     return {{}, s1, s2, s3, (s1 - nu * (s2 + s3)) / e0, (s3 - nu * (s1 + s2)) / e0};
   }
 }
 
+// The damage law in straight-line code, as Principal<2> is.
 template <int Dim>
-double ElasticDamage<Dim>::shear_damage(const Stresses& s, double scale, double stiffness) const {
+[[gnu::always_inline]] inline double ElasticDamage<Dim>::shear_damage(const Stresses& s, double scale,
+                                                                      double stiffness) const {
   const auto& d = parameters_;
-  if (0.5 * (s.s1 - s.s3) < scale * d.cohesion * cos_phi_ - 0.5 * (s.s1 + s.s3) * sin_phi_ || s.eps3 >= 0) return 0;
-  return 1 - d.residual_ratio * scale * ucs_ / (stiffness * this->elasticity().youngs_modulus * -s.eps3);
+  const bool intact =
+      0.5 * (s.s1 - s.s3) < scale * d.cohesion * cos_phi_ - 0.5 * (s.s1 + s.s3) * sin_phi_ || s.eps3 >= 0;
+  const double crushed = 1 - d.residual_ratio * scale * ucs_ / (stiffness * this->elasticity().youngs_modulus * -s.eps3);
+  return intact ? 0.0 : crushed;
 }
 
 template <int Dim>
@@ -226,33 +246,40 @@ double ElasticDamage<Dim>::damage(double previous, const Mat<Dim>& effective, do
 
 template <int Dim>
 double ElasticDamage<Dim>::damage(double previous, const Stresses& st, double scale, double stiffness) const {
+  return parameters_.fracture_energy ? damage<true>(previous, st, scale, stiffness)
+                                     : damage<false>(previous, st, scale, stiffness);
+}
+
+// Band: a crack band's law, else the paper's. A template parameter, since
+// GCC vectorises no choice between them by a flag it must load.
+template <int Dim>
+template <bool Band>
+[[gnu::always_inline]] inline double ElasticDamage<Dim>::damage(double previous, const Stresses& st, double scale,
+                                                                double stiffness) const {
   const auto& d = parameters_;
   const double e0 = stiffness * this->elasticity().youngs_modulus;
   const double s1 = st.s1, eps1 = st.eps1;
-  double damage = previous;
-  if (s1 >= scale * d.tensile_strength) {
-    // The paper's law keeps the residual share of E0 eps_1. A crack band
-    // instead carries a share of f_t that falls linearly in eps_1 from the
-    // onset, the strain at which this stress state reached f_t (eps_1 f_t /
-    // sigma~_1 under proportional loading), to nothing at eps_tu: the area
-    // under the curve is f_t eps_tu / 2 = G_f / w whatever holds the band's
-    // sides. (In E0 eps_1, the paper's form carries (lambda + 2G) / E0 times
-    // more under lateral constraint, and a fixed onset f_t / E0 adds a plateau
-    // at f_t: both make the band dissipate more.)
-    const double ultimate = scale / stiffness * ultimate_strain_;
-    double tensile = 1.0;
-    if (eps1 < ultimate) {
-      if (!d.fracture_energy) {
-        tensile = 1 - d.residual_ratio * scale * d.tensile_strength / (e0 * eps1);
-      } else {
-        // onset <= eps1 < ultimate: the denominator is positive.
-        const double onset = eps1 * scale * d.tensile_strength / s1;
-        tensile = 1 - (ultimate - eps1) / (ultimate - onset) * scale * d.tensile_strength / s1;
-      }
-    }
-    damage = std::max(damage, tensile);
+  // The paper's law keeps the residual share of E0 eps_1. A crack band
+  // instead carries a share of f_t that falls linearly in eps_1 from the
+  // onset, the strain at which this stress state reached f_t (eps_1 f_t /
+  // sigma~_1 under proportional loading), to nothing at eps_tu: the area
+  // under the curve is f_t eps_tu / 2 = G_f / w whatever holds the band's
+  // sides. (In E0 eps_1, the paper's form carries (lambda + 2G) / E0 times
+  // more under lateral constraint, and a fixed onset f_t / E0 adds a plateau
+  // at f_t: both make the band dissipate more.) Where it is chosen (sigma~_1
+  // >= f_t, eps_1 < eps_tu), onset <= eps1 < ultimate: the band's
+  // denominator is positive.
+  const double ultimate = scale / stiffness * ultimate_strain_;
+  double softened;
+  if constexpr (Band) {
+    const double onset = eps1 * scale * d.tensile_strength / s1;
+    softened = 1 - (ultimate - eps1) / (ultimate - onset) * scale * d.tensile_strength / s1;
+  } else {
+    softened = 1 - d.residual_ratio * scale * d.tensile_strength / (e0 * eps1);
   }
-  return std::clamp(std::max(damage, shear_damage(st, scale, stiffness)), 0.0, 1.0);
+  const double tensile = eps1 < ultimate ? softened : 1.0;
+  const double damage = s1 >= scale * d.tensile_strength ? std::max(previous, tensile) : previous;
+  return std::min(std::max(std::max(damage, shear_damage(st, scale, stiffness)), 0.0), 1.0);
 }
 
 template <int Dim>
@@ -353,11 +380,80 @@ template <int Dim>
 Dissipation ElasticDamage<Dim>::update_chunk(Particles<Dim>& p, std::span<const int> members, double dt) const {
   if (!pointwise()) throw std::logic_error("nonlocal damage updates a material's particles together (update_stress)");
   trial(p, members, dt);
-  return each_member(members, [&](int i) {
-    const double zz = Dim == 2 ? p.effective_stress_zz[i] : 0.0, stiffness = modulus_scale(p, i);
-    const Stresses st = principal_stresses(p.effective_stress[i], zz, stiffness);
-    return settle(p, i, damage(p.damage[i], st, strength_scale(p, i), stiffness), st);
-  });
+  if constexpr (Dim == 2) {
+    if (members.empty()) return {};
+    return by_position(members, [&](auto index) {
+      const auto with_band = [&]<bool Drawn>() {
+        return parameters_.fracture_energy ? settle_plane<Drawn, true>(p, members, index)
+                                           : settle_plane<Drawn, false>(p, members, index);
+      };
+      return parameters_.heterogeneity ? with_band.template operator()<true>() : with_band.template operator()<false>();
+    });
+  } else {
+    return each_member(members, [&](int i) {
+      const double stiffness = modulus_scale(p, i);
+      const Stresses st = principal_stresses(p.effective_stress[i], 0.0, stiffness);
+      return settle(p, i, damage(p.damage[i], st, strength_scale(p, i), stiffness), st);
+    });
+  }
+}
+
+// Most of the coal, most of the time, neither cracks further nor slides: its
+// acting stress is all that settle would change. That is found and set for
+// a chunk at once, each particle's arithmetic settle's, so that the lanes
+// move no result; settle itself runs after for the rest, in the members'
+// order, which keeps the sums of what they dissipated.
+template <int Dim>
+template <bool Drawn, bool Band, class Index>
+Dissipation ElasticDamage<Dim>::settle_plane(Particles<Dim>& p, std::span<const int> members, Index index) const {
+  static_assert(Dim == 2);
+  const int n = static_cast<int>(members.size());
+  assert(n <= chunk_size);
+  // Every field by a local pointer, as deform_and_trial's.
+  const double* const effective = p.effective_stress.data()->data();
+  const double* const effective_zz = p.effective_stress_zz.data();
+  const double* const damaged = p.damage.data();
+  const double* const strength = Drawn ? p.strength_scale.data() : nullptr;
+  const double* const modulus = Drawn ? p.modulus_scale.data() : nullptr;
+  double* const acting = p.stress.data()->data();
+  double* const acting_zz = p.stress_zz.data();
+  // Doubles, chosen by nested selects: GCC 12 vectorises no mask combined
+  // by && or stored as bool here.
+  double quick[chunk_size];
+#pragma omp simd
+  for (int k = 0; k < n; ++k) {
+    const std::ptrdiff_t i = index(k);
+    const double* e = effective + 4 * i;
+    const double zz = effective_zz[i], previous = damaged[i];
+    const double scale = Drawn ? strength[i] : 1.0, stiffness = Drawn ? modulus[i] : 1.0;
+    const Principal<2> pr(e[0], e[3], e[2]);
+    const Stresses st = plane_stresses(pr, zz, stiffness);
+    const double d = damage<Band>(previous, st, scale, stiffness);
+    double* s = acting + 4 * i;
+    pr.cracked(1 - d, s);
+    const double s_zz = crack(zz, 1 - d);
+    acting_zz[i] = s_zz;
+    // settle's friction test (its sum, then its cone), the cone's value
+    // summed in another order: the lanes take only what lies inside it by
+    // more than that order's rounding (1e-16 of its terms) could move.
+    const double sum = s[0] + s[3] + s_zz, mean = sum / 3;
+    const double xx = s[0] - mean, yy = s[3] - mean, z = s_zz - mean;
+    const double sqrt_j2 = std::sqrt(0.5 * (xx * xx + s[1] * s[1] + s[2] * s[2] + yy * yy + z * z));
+    const double cone = alpha_ * mean + sqrt_j2, k0 = (1 - d) * scale * k0_;
+    const double holds =
+        sum >= 0 ? 1.0 : cone - k0 < -1e-12 * (std::abs(alpha_ * mean) + sqrt_j2 + k0) ? 1.0 : 0.0;
+    // No growth of damage, and short of full damage (settle caps its bulking).
+    quick[k] = d == previous ? (d < 1 ? holds : 0.0) : 0.0;
+  }
+  Dissipation total;
+  for (int k = 0; k < n; ++k) {
+    if (quick[k] != 0) continue;
+    const int i = static_cast<int>(index(k));
+    const double stiffness = modulus_scale(p, i);
+    const Stresses st = principal_stresses(p.effective_stress[i], p.effective_stress_zz[i], stiffness);
+    total += settle(p, i, damage(p.damage[i], st, strength_scale(p, i), stiffness), st);
+  }
+  return total;
 }
 
 template <int Dim>

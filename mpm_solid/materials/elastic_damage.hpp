@@ -136,10 +136,20 @@ class ElasticDamage final : public Material<Dim> {
   // plane the decomposition of the effective stress they came from.
   struct Stresses;
   Stresses principal_stresses(const Mat<Dim>& effective, double effective_zz, double stiffness) const;
+  // The same from the in-plane matrix's decomposition (a Principal<2>).
+  template <class Plane>
+  Stresses plane_stresses(const Plane& in_plane, double effective_zz, double stiffness) const;
   // Sets particle i's damage to d (no less than it had) and its acting
   // stress, and returns what that dissipated; in the plane it reads the
   // decomposition in st, its effective stress's.
   Dissipation settle(Particles<Dim>& p, int i, double d, const Stresses& st) const;
+  // The plane's pointwise update of a chunk of members after the trial,
+  // member k particle index(k): over SIMD lanes where settling only sets
+  // the acting stress (no damage growth, no friction), by settle elsewhere.
+  template <bool Drawn, bool Band, class Index>
+  Dissipation settle_plane(Particles<Dim>& p, std::span<const int> members, Index index) const;
+  double damage(double previous, const Stresses& st, double scale, double stiffness) const;
+  template <bool Band>
   double damage(double previous, const Stresses& st, double scale, double stiffness) const;
   double shear_damage(const Stresses& s, double scale, double stiffness) const;
   // The local driver of nonlocal damage: eps_1 over the strain at f_t, in
