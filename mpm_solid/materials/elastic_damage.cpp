@@ -399,7 +399,7 @@ Dissipation ElasticDamage<Dim>::update_chunk(Particles<Dim>& p, std::span<const 
 }
 
 // Most of the coal, most of the time, neither cracks further nor slides: its
-// acting stress is all that settle would change. That is found and set for
+// acting stress (and a broken particle's bulking) is all that settle would change. That is found and set for
 // a chunk at once, each particle's arithmetic settle's, so that the lanes
 // move no result; settle itself runs after for the rest, in the members'
 // order, which keeps the sums of what they dissipated.
@@ -417,6 +417,9 @@ Dissipation ElasticDamage<Dim>::settle_plane(Particles<Dim>& p, std::span<const 
   const double* const modulus = Drawn ? p.modulus_scale.data() : nullptr;
   double* const acting = p.stress.data()->data();
   double* const acting_zz = p.stress_zz.data();
+  double* const volume = p.volume.data();
+  const double* const volume0 = p.volume0.data();
+  const double bulking = parameters_.bulking_factor;
   // Doubles, chosen by nested selects: GCC 12 vectorises no mask combined
   // by && or stored as bool here.
   double quick[chunk_size];
@@ -442,8 +445,12 @@ Dissipation ElasticDamage<Dim>::settle_plane(Particles<Dim>& p, std::span<const 
     const double cone = alpha_ * mean + sqrt_j2, k0 = (1 - d) * scale * k0_;
     const double holds =
         sum >= 0 ? 1.0 : cone - k0 < -1e-12 * (std::abs(alpha_ * mean) + sqrt_j2 + k0) ? 1.0 : 0.0;
-    // No growth of damage, and short of full damage (settle caps its bulking).
-    quick[k] = d == previous ? (d < 1 ? holds : 0.0) : 0.0;
+    // No growth of damage. Broken coal, most of the coal once it has burst,
+    // bulks no further than settle lets it; settle's own cap, after its
+    // books, for the particles it takes.
+    quick[k] = d == previous ? holds : 0.0;
+    const double bulked = d >= 1 ? std::min(volume[i], bulking * volume0[i]) : volume[i];
+    volume[i] = quick[k] != 0 ? bulked : volume[i];
   }
   Dissipation total;
   for (int k = 0; k < n; ++k) {

@@ -144,8 +144,9 @@ class ElasticDamage final : public Material<Dim> {
   // decomposition in st, its effective stress's.
   Dissipation settle(Particles<Dim>& p, int i, double d, const Stresses& st) const;
   // The plane's pointwise update of a chunk of members after the trial,
-  // member k particle index(k): over SIMD lanes where settling only sets
-  // the acting stress (no damage growth, no friction), by settle elsewhere.
+  // member k particle index(k): over SIMD lanes where settling only sets the
+  // acting stress (no damage growth, no friction; bulking capped), by settle
+  // elsewhere.
   template <bool Drawn, bool Band, class Index>
   Dissipation settle_plane(Particles<Dim>& p, std::span<const int> members, Index index) const;
   double damage(double previous, const Stresses& st, double scale, double stiffness) const;
