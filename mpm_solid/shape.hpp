@@ -19,18 +19,20 @@ namespace outburst::mpm {
 // floor(x) as an int: std::floor over SIMD lanes needs -fno-trapping-math
 // from GCC, and without it the stencils' loops over a chunk's particles stayed
 // scalar. The truncation, one lower where it rounded up (x negative and not
-// whole), is the same integer. Off int's range (a particle billions of cells
-// off the grid) x86 converts to the lowest int, and one lower wraps to the
-// highest: unsigned, so that the wrap is defined; the stencils' support check
-// refuses either (supported()).
+// whole), is the same integer. x is first held within +-2^30 (a NaN to the
+// low end), since a double beyond int's range has no defined conversion: a
+// particle that far off lies billions of cells off any grid, and the
+// stencils' support check refuses it (supported()). The two selects are a
+// max and a min per lane.
 inline int floor_int(double x) {
-  const int t = static_cast<int>(x);
-  return static_cast<int>(static_cast<unsigned>(t) - (x < t));
+  constexpr double far = 0x1p30;
+  const double held = x > -far ? (x < far ? x : far) : -far;
+  const int t = static_cast<int>(held);
+  return t - (held < t);
 }
 
 // Whether the nodes base .. base + support - 1 lie within 0 .. nodes - 1:
-// unsigned, so that a negative base or one near int's end (floor_int off the
-// grid) fails too, where base + support would wrap.
+// unsigned, so that a negative base fails too.
 inline bool supported(int base, int support, int nodes) {
   return static_cast<unsigned>(base) <= static_cast<unsigned>(nodes - support);
 }
@@ -53,9 +55,7 @@ struct Gimp {
   static constexpr int support = 3;
   static constexpr const char* name = "gimp";
   static inline int eval(double xi, double lp, double* w, double* dw) {
-    // Unsigned, and the nodes' places in double: floor_int wraps to int's
-    // highest far below the grid, and one more would overflow.
-    const int base = static_cast<int>(static_cast<unsigned>(floor_int(xi - 1 - lp)) + 1u);
+    const int base = floor_int(xi - 1 - lp) + 1;
     for (int k = 0; k < 3; ++k) {
       const double r = xi - (static_cast<double>(base) + k);
       const double a = std::abs(r);

@@ -114,10 +114,11 @@ TEST_CASE("supports a billion cells or more off the grid are refused, not wrappe
   far_supports_are_refused<Bspline>();
 }
 
-TEST_CASE("floor_int is std::floor as an int (whole numbers, either side of them, negative and signed zeros), and "
-          "off int's range the support check refuses it",
+TEST_CASE("floor_int is std::floor as an int (whole numbers, either side of them, negative and signed zeros) "
+          "within 2^30, held there beyond, and the support check refuses that",
           "[mpm][stencil]") {
-  std::vector<double> xs{0.0, -0.0, 0.5, -0.5, 1e-300, -1e-300, 2147483646.5, -2147483647.5};
+  std::vector<double> xs{0.0, -0.0, 0.5, -0.5, 1e-300, -1e-300, 1073741823.5, -1073741823.5, 1073741824.0,
+                         -1073741824.0};
   for (int k = -1000; k <= 1000; ++k) {
     const double whole = 0.37 * k - (k % 7);  // whole numbers and fractions on both sides of zero
     for (const double x : {std::floor(whole), whole})
@@ -137,9 +138,13 @@ TEST_CASE("floor_int is std::floor as an int (whole numbers, either side of them
   CHECK(supported(0, support, nodes));
   CHECK(supported(nodes - support, support, nodes));
   CHECK_FALSE(supported(nodes - support + 1, support, nodes));
-  // Off int's range either way (or NaN), the support check refuses it.
-  for (const double x : {-3e9, 3e9, -1e20, 1e20, std::nan("")}) {
+  // Beyond 2^30 either way, off int's range too (where a conversion is
+  // undefined), or NaN: held at 2^30 (NaN at -2^30), which the support
+  // check refuses.
+  constexpr int far = 1 << 30;
+  for (const double x : {-1073741825.0, 1073741825.0, -3e9, 3e9, -1e20, 1e20, -HUGE_VAL, HUGE_VAL, std::nan("")}) {
     INFO("x = " << x);
+    CHECK(floor_int(x) == (x > 0 ? far : -far));
     CHECK_FALSE(supported(floor_int(x), 3, 1000));
   }
 }
