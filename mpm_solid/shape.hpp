@@ -19,20 +19,23 @@ namespace outburst::mpm {
 // floor(x) as an int: std::floor over SIMD lanes needs -fno-trapping-math
 // from GCC, and without it the stencils' loops over a chunk's particles stayed
 // scalar. The truncation, one lower where it rounded up (x negative and not
-// whole), is the same integer. x is first held within +-2^30 (a NaN to the
-// low end), since a double beyond int's range has no defined conversion: a
-// particle that far off lies billions of cells off any grid, and the
-// stencils' support check refuses it (supported()). The two selects are a
-// max and a min per lane.
+// whole), is the same integer. x must lie within int's range, where the
+// conversion is defined: the solver's stencils read only particles on the
+// grid (the census takes the rest, and NaNs, before the next step) and
+// tracers the scene placed on it. Holding x there first cost every kernel
+// 15 % (mpm_solid/benchmark/compare-63e0ffd-de26bb6-290380f-e0a5804.csv):
+// GCC 12 sinks the conversion into the select's branches, where it may trap,
+// and keeps the stencils' loops scalar again. Near int's ends one lower
+// wraps: unsigned, so that the wrap is defined, and the support check
+// refuses it (supported()).
 inline int floor_int(double x) {
-  constexpr double far = 0x1p30;
-  const double held = x > -far ? (x < far ? x : far) : -far;
-  const int t = static_cast<int>(held);
-  return t - (held < t);
+  const int t = static_cast<int>(x);
+  return static_cast<int>(static_cast<unsigned>(t) - (x < t));
 }
 
 // Whether the nodes base .. base + support - 1 lie within 0 .. nodes - 1:
-// unsigned, so that a negative base fails too.
+// unsigned, so that a negative base or one near int's end (floor_int off the
+// grid) fails too, where base + support would wrap.
 inline bool supported(int base, int support, int nodes) {
   return static_cast<unsigned>(base) <= static_cast<unsigned>(nodes - support);
 }
@@ -55,7 +58,9 @@ struct Gimp {
   static constexpr int support = 3;
   static constexpr const char* name = "gimp";
   static inline int eval(double xi, double lp, double* w, double* dw) {
-    const int base = floor_int(xi - 1 - lp) + 1;
+    // Unsigned, and the nodes' places in double: floor_int wraps to int's
+    // highest far below the grid, and one more would overflow.
+    const int base = static_cast<int>(static_cast<unsigned>(floor_int(xi - 1 - lp)) + 1u);
     for (int k = 0; k < 3; ++k) {
       const double r = xi - (static_cast<double>(base) + k);
       const double a = std::abs(r);
