@@ -470,6 +470,9 @@ block("outburst cost motion lanes", "cases/outburst/benchmark/outburst-benchmark
 block("mpm benchmark census lanes", "mpm_solid/benchmark/compare-63e0ffd-a49a143-e7788a0.csv")(mpm_benchmark_builds)
 block("mpm benchmark 3d census lanes", "mpm_solid/benchmark/compare-3d-a49a143-e7788a0.csv")(mpm_benchmark_builds)
 block("outburst cost census lanes", "cases/outburst/benchmark/outburst-benchmark-census-lanes.csv")(outburst_cost)
+block("mpm benchmark settle lanes", "mpm_solid/benchmark/compare-63e0ffd-de26bb6-290380f-e0a5804.csv")(
+    mpm_benchmark_builds)
+block("outburst cost settle lanes", "cases/outburst/benchmark/outburst-benchmark-settle-lanes.csv")(outburst_cost)
 
 
 @block("mpm benchmark", "mpm_solid/benchmark/mpm-benchmark.csv")
