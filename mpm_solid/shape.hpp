@@ -20,13 +20,14 @@ namespace outburst::mpm {
 // from GCC, and without it the stencils' loops over a chunk's particles stayed
 // scalar. The truncation, one lower where it rounded up (x negative and not
 // whole), is the same integer. x must lie within int's range, where the
-// conversion is defined: the solver's stencils read only particles on the
-// grid (the census takes the rest, and NaNs, before the next step) and
-// tracers the scene placed on it. Holding x there first cost every kernel
-// 15 % (mpm_solid/benchmark/compare-63e0ffd-de26bb6-290380f-e0a5804.csv):
-// GCC 12 sinks the conversion into the select's branches, where it may trap,
-// and keeps the stencils' loops scalar again. Near int's ends one lower
-// wraps: unsigned, so that the wrap is defined, and the support check
+// conversion is defined: the solver's stencils read the particles and
+// tracers a scene placed on the grid, and after each step only the
+// particles still on it (the census removes the ones that left and stops
+// the run at a non-finite position). Holding x there first cost every
+// kernel 15 % (mpm_solid/benchmark/compare-63e0ffd-de26bb6-290380f-e0a5804.csv):
+// GCC 12 sinks the conversion into the select's branches, where it may
+// trap, and keeps the stencils' loops scalar again. Near int's ends one
+// lower wraps: unsigned, so that the wrap is defined, and the support check
 // refuses it (supported()).
 inline int floor_int(double x) {
   const int t = static_cast<int>(x);

@@ -381,14 +381,21 @@ Dissipation ElasticDamage<Dim>::update_chunk(Particles<Dim>& p, std::span<const 
   if (!pointwise()) throw std::logic_error("nonlocal damage updates a material's particles together (update_stress)");
   trial(p, members, dt);
   if constexpr (Dim == 2) {
-    if (members.empty()) return {};
-    return by_position(members, [&](auto index) {
-      const auto with_band = [&]<bool Drawn>() {
-        return parameters_.fracture_energy ? settle_plane<Drawn, true>(p, members, index)
-                                           : settle_plane<Drawn, false>(p, members, index);
-      };
-      return parameters_.heterogeneity ? with_band.template operator()<true>() : with_band.template operator()<false>();
-    });
+    // The solver's chunks are chunk_size long; a longer call in pieces of it,
+    // the lanes' verdicts' length.
+    Dissipation total;
+    for (std::size_t first = 0; first < members.size(); first += chunk_size) {
+      const auto part = members.subspan(first, std::min<std::size_t>(chunk_size, members.size() - first));
+      total += by_position(part, [&](auto index) {
+        const auto with_band = [&]<bool Drawn>() {
+          return parameters_.fracture_energy ? settle_plane<Drawn, true>(p, part, index)
+                                             : settle_plane<Drawn, false>(p, part, index);
+        };
+        return parameters_.heterogeneity ? with_band.template operator()<true>()
+                                         : with_band.template operator()<false>();
+      });
+    }
+    return total;
   } else {
     return each_member(members, [&](int i) {
       const double stiffness = modulus_scale(p, i);
@@ -399,10 +406,13 @@ Dissipation ElasticDamage<Dim>::update_chunk(Particles<Dim>& p, std::span<const 
 }
 
 // Most of the coal, most of the time, neither cracks further nor slides: its
-// acting stress (and a broken particle's bulking) is all that settle would change. That is found and set for
-// a chunk at once, each particle's arithmetic settle's, so that the lanes
-// move no result; settle itself runs after for the rest, in the members'
-// order, which keeps the sums of what they dissipated.
+// acting stress (and a broken particle's bulking) is all that settle would
+// change. That is found and set for a chunk at once, each particle's
+// arithmetic settle's, so that the lanes move no result where the compiler
+// fuses no products of its own (-DOUTBURST_NO_FP_CONTRACTION=ON; with its
+// fused multiply-adds, placed apart in vector and scalar code, an ulp);
+// settle itself runs after for the rest, in the members' order, which keeps
+// the sums of what they dissipated.
 template <int Dim>
 template <bool Drawn, bool Band, class Index>
 Dissipation ElasticDamage<Dim>::settle_plane(Particles<Dim>& p, std::span<const int> members, Index index) const {
