@@ -6,6 +6,7 @@
 #include <cassert>
 #include <numeric>
 #include <cmath>
+#include <limits>
 #include <type_traits>
 
 #include <fmt/format.h>
@@ -411,8 +412,8 @@ template <int Dim>
 double stable_time_step(const std::vector<std::unique_ptr<Material<Dim>>>& materials,
                         const Particles<Dim>& particles, double h, double courant) {
   const std::ptrdiff_t n = static_cast<std::ptrdiff_t>(particles.size());
+  if (n == 0) return std::numeric_limits<double>::infinity();
   double fastest = 0;
-  if (n == 0) return courant * h / fastest;
   const std::vector<double> p_modulus = p_moduli(materials);
   const Speeds speeds(p_modulus, nullptr, particles);
   const double* velocity = particles.v.data()->data();

@@ -397,12 +397,15 @@ Dissipation ElasticDamage<Dim>::update_chunk(Particles<Dim>& p, std::span<const 
     }
     return total;
   } else {
-    return each_member(members, [&](int i) {
-      const double stiffness = modulus_scale(p, i);
-      const Stresses st = principal_stresses(p.effective_stress[i], 0.0, stiffness);
-      return settle(p, i, damage(p.damage[i], st, strength_scale(p, i), stiffness), st);
-    });
+    return each_member(members, [&](int i) { return update_alone(p, i); });
   }
+}
+
+template <int Dim>
+Dissipation ElasticDamage<Dim>::update_alone(Particles<Dim>& p, int i) const {
+  const double stiffness = modulus_scale(p, i), zz = Dim == 2 ? p.effective_stress_zz[i] : 0.0;
+  const Stresses st = principal_stresses(p.effective_stress[i], zz, stiffness);
+  return settle(p, i, damage(p.damage[i], st, strength_scale(p, i), stiffness), st);
 }
 
 // Most of the coal, most of the time, neither cracks further nor slides: its
@@ -463,13 +466,8 @@ Dissipation ElasticDamage<Dim>::settle_plane(Particles<Dim>& p, std::span<const 
     volume[i] = quick[k] != 0 ? bulked : volume[i];
   }
   Dissipation total;
-  for (int k = 0; k < n; ++k) {
-    if (quick[k] != 0) continue;
-    const int i = static_cast<int>(index(k));
-    const double stiffness = modulus_scale(p, i);
-    const Stresses st = principal_stresses(p.effective_stress[i], p.effective_stress_zz[i], stiffness);
-    total += settle(p, i, damage(p.damage[i], st, strength_scale(p, i), stiffness), st);
-  }
+  for (int k = 0; k < n; ++k)
+    if (quick[k] == 0) total += update_alone(p, static_cast<int>(index(k)));
   return total;
 }
 

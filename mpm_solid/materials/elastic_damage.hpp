@@ -143,6 +143,9 @@ class ElasticDamage final : public Material<Dim> {
   // stress, and returns what that dissipated; in the plane it reads the
   // decomposition in st, its effective stress's.
   Dissipation settle(Particles<Dim>& p, int i, double d, const Stresses& st) const;
+  // Particle i's pointwise update after the trial, one particle at a time:
+  // its decomposition, the damage law and settle.
+  Dissipation update_alone(Particles<Dim>& p, int i) const;
   // The plane's pointwise update of a chunk of members after the trial,
   // member k particle index(k): over SIMD lanes where settling only sets the
   // acting stress (no damage growth, no friction; bulking capped), by settle
