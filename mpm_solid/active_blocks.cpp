@@ -25,13 +25,6 @@ ActiveBlocks<Dim>::ActiveBlocks(const Grid<Dim>& grid, const std::array<bool, 2 
 }
 
 template <int Dim>
-std::size_t ActiveBlocks<Dim>::block_index(const std::array<int, Dim>& b) const {
-  std::size_t flat = 0;
-  for (int d = Dim - 1; d >= 0; --d) flat = flat * static_cast<std::size_t>(blocks_[d]) + static_cast<std::size_t>(b[d]);
-  return flat;
-}
-
-template <int Dim>
 void ActiveBlocks<Dim>::collect() {
   std::fill(active_.begin(), active_.end(), 0);
   for (auto& m : marks_)

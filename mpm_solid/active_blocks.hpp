@@ -57,6 +57,13 @@ class ActiveBlocks {
     }
   }
 
+  // Whether the block holding node ij is active.
+  bool holds(const std::array<int, Dim>& ij) const {
+    std::array<int, Dim> b;
+    for (int d = 0; d < Dim; ++d) b[d] = ij[d] / size;
+    return active_[block_index(b)];
+  }
+
   // The threads' marks (cleared) become the active blocks, with the walls'
   // mirrors, and their nodes the runs below.
   void collect();
@@ -68,7 +75,12 @@ class ActiveBlocks {
   std::size_t bytes() const;
 
  private:
-  std::size_t block_index(const std::array<int, Dim>& b) const;
+  std::size_t block_index(const std::array<int, Dim>& b) const {
+    std::size_t flat = 0;
+    for (int d = Dim - 1; d >= 0; --d)
+      flat = flat * static_cast<std::size_t>(blocks_[d]) + static_cast<std::size_t>(b[d]);
+    return flat;
+  }
 
   std::array<int, Dim> nodes_, blocks_;
   std::array<int, Dim - 1> strides_;

@@ -370,7 +370,7 @@ Solver<Dim>::Solver(Grid<Dim> grid, std::vector<std::unique_ptr<Material<Dim>>> 
 template <int Dim>
 void Solver<Dim>::find_obstacle_nodes() {
   const double tolerance = 1e-9 * grid_.h;
-  obstacle_nodes_.clear();
+  obstacle_nodes_.assign(settings_.obstacles.size(), {});
   for (std::size_t k = 0; k < settings_.obstacles.size(); ++k) {
     const Obstacle<Dim>& o = settings_.obstacles[k];
     if (!(o.upper.array() > o.lower.array()).all())
@@ -392,7 +392,7 @@ void Solver<Dim>::find_obstacle_nodes() {
       for (int f = 0; f < 2 * Dim; ++f)
         if (distance[f] <= nearest + tolerance) n += (f % 2 == 0 ? 1.0 : -1.0) * Vec<Dim>::Unit(f / 2);
       if (n.squaredNorm() == 0) continue;  // the centre of a square obstacle: no material reaches it
-      obstacle_nodes_.push_back({i, n.normalized(), k});
+      obstacle_nodes_[k].push_back({i, n.normalized()});
     }
   }
 }
@@ -752,12 +752,17 @@ void Solver<Dim>::over_layer(int axis, int row, F&& f) const {
   std::array<int, Dim> ij{};
   ij[axis] = row;
   const int a = axis == 0 ? 1 : 0, b = axis == 2 ? 1 : 2;  // the other axes (b: 3D only)
-  const int layers = Dim == 2 ? 1 : grid_.nodes_along(b);
+  const int layers = Dim == 2 ? 1 : grid_.nodes_along(b), along = grid_.nodes_along(a);
+  constexpr int size = ActiveBlocks<Dim>::size;
   for (int l = 0; l < layers; ++l) {
     if constexpr (Dim == 3) ij[b] = l;
-    for (int k = 0; k < grid_.nodes_along(a); ++k) {
-      ij[a] = k;
-      f(ij);
+    for (int from = 0; from < along; from += size) {
+      ij[a] = from;
+      if (!active_.holds(ij)) continue;
+      for (int k = from; k < std::min(from + size, along); ++k) {
+        ij[a] = k;
+        f(ij);
+      }
     }
   }
 }
@@ -836,12 +841,23 @@ double Solver<Dim>::apply_walls(std::vector<Vec<Dim>>& velocity) const {
     }
     if (depth > 0) continue;
     // Most of an obstacle's nodes lie deep in the rock, where no particle
-    // reaches: at rest, which every contact leaves at rest.
-    for (const auto& o : obstacle_nodes_)
-      if (const Vec<Dim>& v = velocity[o.node]; (v.array() != 0).any()) {
-        const double work = constrain(velocity[o.node], o.normal, settings_.obstacles[o.obstacle].contact, mass_[o.node]);
-        if (counted_[o.node]) friction_work += work;
+    // reaches: outside the active runs, at rest, which every contact leaves
+    // at rest. Both lists are in node order: a walk along the runs visits
+    // the rest in the order they are listed.
+    for (std::size_t k = 0; k < obstacle_nodes_.size(); ++k) {
+      const Wall& contact = settings_.obstacles[k].contact;
+      auto o = obstacle_nodes_[k].cbegin();
+      const auto end = obstacle_nodes_[k].cend();
+      for (const NodeRun& run : active_.runs()) {
+        o = std::lower_bound(o, end, run.first, [](const ObstacleNode& a, std::size_t i) { return a.node < i; });
+        for (; o != end && o->node < run.first + static_cast<std::size_t>(run.count); ++o)
+          if (const Vec<Dim>& v = velocity[o->node]; (v.array() != 0).any()) {
+            const double work = constrain(velocity[o->node], o->normal, contact, mass_[o->node]);
+            if (counted_[o->node]) friction_work += work;
+          }
+        if (o == end) break;
       }
+    }
   }
   return friction_work;
 }

@@ -331,7 +331,8 @@ class Solver {
   void remove_supports();  // the settling stage is over
   void fold_ghosts(std::vector<double>* mass, std::vector<Vec<Dim>>& vectors) const;
   // f(node) over the nodes of the layer `row` across `axis` (a row of nodes
-  // in 2D, a plane in 3D), ghosts included.
+  // in 2D, a plane in 3D), ghosts included, in active blocks: elsewhere every
+  // nodal value is zero, which walls and folds leave so.
   template <class F>
   void over_layer(int axis, int row, F&& f) const;
   void update_stresses(double dt);
@@ -377,9 +378,8 @@ class Solver {
   struct ObstacleNode {
     std::size_t node;
     Vec<Dim> normal;  // unit, pointing into the obstacle
-    std::size_t obstacle;
   };
-  std::vector<ObstacleNode> obstacle_nodes_;
+  std::vector<std::vector<ObstacleNode>> obstacle_nodes_;  // per obstacle, in node order
   std::vector<std::vector<std::size_t>> platen_nodes_;  // the nodes each platen holds
   std::vector<double> platen_displacement_;
   std::vector<double> platen_force_;
