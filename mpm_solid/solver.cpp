@@ -6,6 +6,7 @@
 #include <cassert>
 #include <numeric>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <type_traits>
 
@@ -63,14 +64,15 @@ struct Scatter {
     over_nodes(runs, [&](std::size_t i) { total[i] = zero<T>(); });
   }
   std::vector<T>& buffer(int t) { return t == 0 ? total : others[static_cast<std::size_t>(t - 1)]; }
+  // Adds thread t's copy into the total at node i, and clears the copy.
+  void gather(std::size_t i) {
+    for (auto& part : others) {
+      total[i] += part[i];
+      part[i] = zero<T>();
+    }
+  }
   void gather() {
-    if (others.empty()) return;
-    over_nodes(runs, [&](std::size_t i) {
-      for (auto& part : others) {
-        total[i] += part[i];
-        part[i] = zero<T>();
-      }
-    });
+    if (!others.empty()) over_nodes(runs, [&](std::size_t i) { gather(i); });
   }
 };
 
@@ -497,8 +499,11 @@ void Solver<Dim>::scatter_mass_momentum() {
   if (outside > 0)
     throw SimulationError(fmt::format("mpm: step {}: {} particles lie beyond the grid's ghost nodes", steps_ + 1,
                                       outside));
-  masses.gather();
-  momenta.gather();
+  if (!masses.others.empty())
+    over_nodes(active_.runs(), [&](std::size_t i) {
+      masses.gather(i);
+      momenta.gather(i);
+    });
   fold_ghosts(&mass_, momentum_);
 }
 
@@ -519,10 +524,15 @@ std::size_t Solver<Dim>::stray_nodal_values() const {
 
 template <int Dim>
 void Solver<Dim>::clear_grid() {
-  over_nodes(active_.runs(), [&](std::size_t i) {
-    mass_[i] = 0;
-    momentum_[i] = force_[i] = velocity_[i] = velocity_new_[i] = Vec<Dim>::Zero();
-  });
+  const Runs& runs = active_.runs();
+  const int n = static_cast<int>(runs.size());
+#pragma omp parallel for schedule(static)
+  for (int r = 0; r < n; ++r) {
+    const auto [first, count] = runs[static_cast<std::size_t>(r)];
+    std::fill_n(mass_.begin() + static_cast<std::ptrdiff_t>(first), count, 0.0);
+    for (auto* field : {&momentum_, &force_, &velocity_, &velocity_new_})
+      std::memset(static_cast<void*>(field->data() + first), 0, sizeof(Vec<Dim>) * static_cast<std::size_t>(count));
+  }
 }
 
 template <int Dim>
@@ -657,8 +667,8 @@ template <class Shape>
 void Solver<Dim>::update_and_scatter(double dt) {
   auto& p = particles_;
   const ForceTerms<Dim> terms = force_terms(p, settings_);
+  // force_ is zero: clear_grid zeroed the grid, and no pass has used it since.
   Scatter<Vec<Dim>> forces{thread_vector_, force_, active_.runs()};
-  forces.clear();
   double plastic = 0, damage = 0;
 #pragma omp parallel num_threads(threads_) reduction(+ : plastic, damage)
   {
