@@ -178,6 +178,7 @@ int run_in(const RunOptions& options, scene::Document& doc) {
                "{} particles left the grid",
                coupler.records().size(), driver.iterations, solid.steps(), wall, seepage_solver.balance().total_outflow(),
                Dim == 2 ? "m3/m" : "m3", solid.removed_particles());
+  spdlog::info("MPM steps' wall time: {}", mpm::describe(solid.step_times()));
   spdlog::info("results: {}", std::filesystem::absolute(directory).string());
   return 0;
 }

@@ -1119,8 +1119,16 @@ template <int Dim>
 template <class Shape, Scheme S, bool Apic>
 void Solver<Dim>::step_kernel(double dt) {
   if constexpr (S != Scheme::usf) displacement_.resize(particles_.size());
+  double start = omp_get_wtime();
+  const auto lap = [&](double& part) {
+    const double now = omp_get_wtime();
+    part += now - start;
+    start = now;
+  };
   scatter_mass_momentum<Shape, Apic>();
+  lap(times_.map);
   grid_velocities();
+  lap(times_.grid);
   if constexpr (S == Scheme::usf) {
     if (pointwise_) {
       update_and_scatter<Shape>(dt);
@@ -1133,21 +1141,36 @@ void Solver<Dim>::step_kernel(double dt) {
   } else {
     scatter_forces<Shape>();
   }
+  lap(times_.stress);
   grid_update(dt);
+  lap(times_.grid);
   gather_motion<Shape, Apic, S == Scheme::usf>(dt);
+  lap(times_.motion);
   if constexpr (S == Scheme::musl) {
     // Map the updated particle momentum back and take the velocity gradient of
     // that field: empty-ish nodes no longer carry the grid update's noise.
     scatter_mass_momentum<Shape, Apic>();
+    lap(times_.map);
     grid_velocities();
+    lap(times_.grid);
   }
   if constexpr (S != Scheme::usf) {
     if constexpr (S == Scheme::usl) velocity_.swap(velocity_new_);
     gather_velocity_gradient<Shape>();
     if (settings_.smooth_dilatation) smooth_dilatation<Shape>();
     update_stresses(dt);
+    lap(times_.stress);
     census_ = move_particles(dt);
+    lap(times_.motion);
   }
+}
+
+std::string describe(const StepTimes& t) {
+  const double total = t.map + t.grid + t.stress + t.motion;
+  const auto share = [total](double part) { return total > 0 ? 100 * part / total : 0.0; };
+  return fmt::format("particles to grid {:.0f} %, grid {:.0f} %, stresses and forces {:.0f} %, grid to particles "
+                     "{:.0f} % of {:.3g} s",
+                     share(t.map), share(t.grid), share(t.stress), share(t.motion), total);
 }
 
 template <int Dim>

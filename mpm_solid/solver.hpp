@@ -187,6 +187,17 @@ struct StepInfo {
   std::size_t removed = 0;  // particles that left the grid this step
 };
 
+// Wall time the steps have spent in each of their parts, in seconds: where a
+// run's time goes, and which part a second thread speeds up.
+struct StepTimes {
+  double map = 0;     // particles to grid: mass and momentum
+  double grid = 0;    // the grid's velocities and update, walls, platens
+  double stress = 0;  // velocity gradients, the stress update, nodal forces
+  double motion = 0;  // grid to particles: velocities, positions, the census
+};
+// "particles to grid 18 %, grid 9 %, ... of 93.1 s".
+std::string describe(const StepTimes& t);
+
 // What the last pass over the particles in a step found: the work of the
 // external forces over the step and the particles that went wrong or left.
 // The same pass finds the fastest signal, max (c_p + |v_p|), over the
@@ -235,6 +246,7 @@ class Solver {
 
   double time() const { return time_; }
   long steps() const { return steps_; }
+  const StepTimes& step_times() const { return times_; }
   std::size_t removed_particles() const { return removed_; }
   const Grid<Dim>& grid() const { return grid_; }
   const Settings<Dim>& settings() const { return settings_; }
@@ -387,6 +399,7 @@ class Solver {
 
   double time_ = 0;
   long steps_ = 0;
+  StepTimes times_;
   std::size_t removed_ = 0;
   Energies dissipated_;  // only the accumulated members are used
   bool settled_ = false;  // a settling stage ran: its supports are gone

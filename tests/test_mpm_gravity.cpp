@@ -2,6 +2,7 @@
 // nearly incompressible), and a step beyond the stable one under it.
 #include <catch2/catch.hpp>
 
+#include <chrono>
 #include <cmath>
 
 #include "common/program.hpp"
@@ -93,4 +94,28 @@ TEST_CASE("a step far beyond the stable one stops the run naming step, particle 
                             (Catch::Contains("velocity") || Catch::Contains("non-finite")));
     std::printf("\nunstable run stopped: %s\n", message.c_str());
   }
+}
+
+TEST_CASE("the steps' wall time is booked to their parts, in every scheme", "[mpm]") {
+  const Scheme scheme = GENERATE(Scheme::usf, Scheme::usl, Scheme::musl);
+  const Grid<2> gr = grid(4.0, 4.0, 0.25);
+  Settings<2> s;
+  s.scheme = scheme;
+  s.gravity = {0, -9.81};
+  s.walls[2] = {Wall::Type::fixed};
+  Solver<2> solver(gr, elastic({1000, 1e7, 0.3}), block(gr, {1, 0}, {3, 2}, 1000, 2), s);
+  const double dt = solver.stable_time_step();
+  const auto start = std::chrono::steady_clock::now();
+  for (int i = 0; i < 50; ++i) solver.step(dt);
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const StepTimes& t = solver.step_times();
+  CHECK(t.map > 0);
+  CHECK(t.grid > 0);
+  CHECK(t.stress > 0);
+  CHECK(t.motion > 0);
+  // The parts are the steps' time but the census's removals, booked once.
+  const double booked = t.map + t.grid + t.stress + t.motion;
+  CHECK(booked <= 1.01 * wall + 1e-4);
+  CHECK(booked >= 0.5 * wall);
+  CHECK_THAT(describe(t), Catch::StartsWith("particles to grid ") && Catch::EndsWith(" s"));
 }
