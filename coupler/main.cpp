@@ -174,11 +174,11 @@ int run_in(const RunOptions& options, scene::Document& doc) {
                  coupler.time(), solid.kinetic_energy(), energy_unit, *header.rest_fraction,
                  loop.peak_kinetic_energy());
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  spdlog::info("MPM steps' wall time: {}", mpm::describe(solid.step_times()));
   spdlog::info("done: {} windows, {} sub-iterations, {} MPM steps, {:.3g} s wall; gas released {:.4g} {}, "
                "{} particles left the grid",
                coupler.records().size(), driver.iterations, solid.steps(), wall, seepage_solver.balance().total_outflow(),
                Dim == 2 ? "m3/m" : "m3", solid.removed_particles());
-  spdlog::info("MPM steps' wall time: {}", mpm::describe(solid.step_times()));
   spdlog::info("results: {}", std::filesystem::absolute(directory).string());
   return 0;
 }

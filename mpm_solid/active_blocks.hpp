@@ -3,9 +3,9 @@
 // 4 x 4 x 4 in 3D) that some particle's stencil reaches, and beside a fixed or
 // roller wall the blocks its ghost nodes mirror into. Every nodal array is
 // zero outside them, so the grid's own passes (clearing, summing the threads'
-// copies, velocities, the update, the energy books) run over these nodes only,
-// and a mostly empty grid (a long tunnel, rock around a seam) costs in
-// proportion to its particles.
+// copies, velocities, the update, the energy books, the walls, ghost folds
+// and obstacles) run over these nodes only, and a mostly empty grid (a long
+// tunnel, rock around a seam) costs in proportion to its particles.
 
 #include <array>
 #include <cstdint>

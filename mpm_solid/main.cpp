@@ -107,10 +107,10 @@ int run_in(const RunOptions& options, scene::Document& doc, const SceneHeader& h
                  solver.time(), solver.kinetic_energy(), Dim == 2 ? "J/m" : "J", *header.rest_fraction,
                  loop.peak_kinetic_energy());
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  spdlog::info("steps' wall time: {}", describe(solver.step_times()));
   spdlog::info("done: {} steps, {:.3g} s wall, {:.3g} particle-steps/s, {} particles left the grid",
                solver.steps(), wall, static_cast<double>(solver.steps()) * static_cast<double>(solver.particles().size()) / wall,
                solver.removed_particles());
-  spdlog::info("steps' wall time: {}", describe(solver.step_times()));
   spdlog::info("results: {}", std::filesystem::absolute(out.series().index_path()).string());
   return 0;
 }

@@ -6,7 +6,6 @@
 #include <cassert>
 #include <numeric>
 #include <cmath>
-#include <cstring>
 #include <limits>
 #include <type_traits>
 
@@ -529,9 +528,10 @@ void Solver<Dim>::clear_grid() {
 #pragma omp parallel for schedule(static)
   for (int r = 0; r < n; ++r) {
     const auto [first, count] = runs[static_cast<std::size_t>(r)];
-    std::fill_n(mass_.begin() + static_cast<std::ptrdiff_t>(first), count, 0.0);
+    const auto from = static_cast<std::ptrdiff_t>(first);
+    std::fill_n(mass_.begin() + from, count, 0.0);
     for (auto* field : {&momentum_, &force_, &velocity_, &velocity_new_})
-      std::memset(static_cast<void*>(field->data() + first), 0, sizeof(Vec<Dim>) * static_cast<std::size_t>(count));
+      std::fill_n(field->begin() + from, count, Vec<Dim>::Zero());
   }
 }
 
@@ -667,7 +667,8 @@ template <class Shape>
 void Solver<Dim>::update_and_scatter(double dt) {
   auto& p = particles_;
   const ForceTerms<Dim> terms = force_terms(p, settings_);
-  // force_ is zero: clear_grid zeroed the grid, and no pass has used it since.
+  // force_ is zero: clear_grid zeroed it, and the pointwise update runs
+  // without smooth_dilatation, the one pass that borrows it before the forces.
   Scatter<Vec<Dim>> forces{thread_vector_, force_, active_.runs()};
   double plastic = 0, damage = 0;
 #pragma omp parallel num_threads(threads_) reduction(+ : plastic, damage)
@@ -809,6 +810,7 @@ void Solver<Dim>::fold_ghosts(std::vector<double>* mass, std::vector<Vec<Dim>>& 
 // shape functions a whole order of accuracy). Obstacles act between the wall
 // rows and the ghost rows: a ghost mirrors an obstacle's node as the obstacle
 // leaves it (read before, its velocity changed where no energy book saw it).
+// Only the active blocks, as this step's mapping collected them, are visited.
 // Returns the work done by friction.
 template <int Dim>
 double Solver<Dim>::apply_walls(std::vector<Vec<Dim>>& velocity) const {
@@ -852,20 +854,26 @@ double Solver<Dim>::apply_walls(std::vector<Vec<Dim>>& velocity) const {
     if (depth > 0) continue;
     // Most of an obstacle's nodes lie deep in the rock, where no particle
     // reaches: outside the active runs, at rest, which every contact leaves
-    // at rest. Both lists are in node order: a walk along the runs visits
-    // the rest in the order they are listed.
+    // at rest. Both lists are in node order (find_obstacle_nodes goes along
+    // the nodes), so a walk along the runs from the obstacle's first node
+    // visits its active nodes in the order the full list would.
+    const auto& runs = active_.runs();
     for (std::size_t k = 0; k < obstacle_nodes_.size(); ++k) {
       const Wall& contact = settings_.obstacles[k].contact;
       auto o = obstacle_nodes_[k].cbegin();
       const auto end = obstacle_nodes_[k].cend();
-      for (const NodeRun& run : active_.runs()) {
-        o = std::lower_bound(o, end, run.first, [](const ObstacleNode& a, std::size_t i) { return a.node < i; });
-        for (; o != end && o->node < run.first + static_cast<std::size_t>(run.count); ++o)
+      if (o == end) continue;
+      // The first run that ends beyond the obstacle's first node.
+      auto run = std::upper_bound(runs.begin(), runs.end(), o->node, [](std::size_t i, const NodeRun& r) {
+        return i < r.first + static_cast<std::size_t>(r.count);
+      });
+      for (; run != runs.end() && o != end; ++run) {
+        o = std::lower_bound(o, end, run->first, [](const ObstacleNode& a, std::size_t i) { return a.node < i; });
+        for (; o != end && o->node < run->first + static_cast<std::size_t>(run->count); ++o)
           if (const Vec<Dim>& v = velocity[o->node]; (v.array() != 0).any()) {
             const double work = constrain(velocity[o->node], o->normal, contact, mass_[o->node]);
             if (counted_[o->node]) friction_work += work;
           }
-        if (o == end) break;
       }
     }
   }
@@ -1303,6 +1311,7 @@ std::optional<double> Solver<Dim>::settle(const Settling& stage, std::optional<d
   fastest_ = 0;
   time_ = 0;
   steps_ = 0;
+  times_ = {};
   dissipated_ = {};
   std::fill(platen_displacement_.begin(), platen_displacement_.end(), 0.0);
   return settling_peak_ > 0 ? settling_kinetic_ / settling_peak_ : 0.0;

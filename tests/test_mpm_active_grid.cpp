@@ -26,7 +26,9 @@ struct Run {
 };
 
 // A block dropped on a fixed floor beside a fixed left wall, thrown to the
-// right, for 300 steps, on a grid `width` wide with an open right side.
+// right, for 300 steps, on a grid `width` wide with an open right side, into
+// rigid steps on the floor as wide as the grid, overlapping each other and
+// the floor's row, most of whose nodes lie in blocks no particle reaches.
 Run drop(double width, ShapeKind shape, Scheme scheme) {
   const Grid<2> g = grid(width, 2.0, 0.1);
   Particles<2> p = block(g, Vec<2>(0.0, 0.0), Vec<2>(1.0, 0.8), 1000, 2);
@@ -36,6 +38,8 @@ Run drop(double width, ShapeKind shape, Scheme scheme) {
   s.scheme = scheme;
   s.gravity = {0, -9.81};
   s.walls = {Wall{Wall::Type::fixed}, Wall{}, Wall{Wall::Type::fixed}, Wall{}};
+  s.obstacles.push_back({Vec<2>(1.05, 0.0), Vec<2>(width, 0.1), Wall{Wall::Type::friction, 0.3}, false});
+  s.obstacles.push_back({Vec<2>(1.1, 0.0), Vec<2>(width - 0.2, 0.15), Wall{Wall::Type::roller}, false});
   Solver<2> solver(g, elastic({1000, 1e7, 0.3}), std::move(p), s);
   const double dt = solver.stable_time_step();
   for (int k = 0; k < 300; ++k) solver.step(dt);

@@ -113,9 +113,8 @@ TEST_CASE("the steps' wall time is booked to their parts, in every scheme", "[mp
   CHECK(t.grid > 0);
   CHECK(t.stress > 0);
   CHECK(t.motion > 0);
-  // The parts are the steps' time but the census's removals, booked once.
-  const double booked = t.map + t.grid + t.stress + t.motion;
-  CHECK(booked <= 1.01 * wall + 1e-4);
-  CHECK(booked >= 0.5 * wall);
+  // Within the steps' time: what step() does around the kernel (the removal
+  // of escaped particles) is booked to no part.
+  CHECK(t.map + t.grid + t.stress + t.motion <= 1.01 * wall + 1e-4);
   CHECK_THAT(describe(t), Catch::StartsWith("particles to grid ") && Catch::EndsWith(" s"));
 }
