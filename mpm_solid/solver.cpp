@@ -63,7 +63,7 @@ struct Scatter {
     over_nodes(runs, [&](std::size_t i) { total[i] = zero<T>(); });
   }
   std::vector<T>& buffer(int t) { return t == 0 ? total : others[static_cast<std::size_t>(t - 1)]; }
-  // Adds thread t's copy into the total at node i, and clears the copy.
+  // Adds the other threads' copies into the total at node i, and clears them.
   void gather(std::size_t i) {
     for (auto& part : others) {
       total[i] += part[i];
