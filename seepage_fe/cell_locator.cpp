@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "seepage_fe/q1.hpp"
 
@@ -91,7 +92,8 @@ CellLocatorOf<Dim>::CellLocatorOf(const MeshOf<Dim>& mesh) : mesh_(mesh) {
     if (const auto map = affine_map(x, (chi - clo).maxCoeff()))
       affine_.push_back(Affine{map->first, map->second});
     else
-      affine_.emplace_back();
+      affine_.push_back(Affine{Point::Constant(std::numeric_limits<double>::quiet_NaN()),
+                               Jacobian::Constant(std::numeric_limits<double>::quiet_NaN())});
     std::array<int, Dim> first, last;
     for (int d = 0; d < Dim; ++d) {
       first[d] = bucket_index(clo, d);
@@ -122,16 +124,19 @@ int CellLocatorOf<Dim>::bucket_index(const Point& p, int axis) const {
 
 template <int Dim>
 auto CellLocatorOf<Dim>::reference(std::size_t c, const Point& point) const -> std::optional<Point> {
-  if (!affine_[c]) return q1::inverse_map(mesh_.corners(c), point);
-  // The acceptance of q1::inverse_map: a point on a shared edge is found.
-  const Point ref = affine_[c]->inverse_jacobian * (point - affine_[c]->centre);
-  if (ref.template lpNorm<Eigen::Infinity>() > 1 + 1e-9) return std::nullopt;
-  return Point(ref.cwiseMax(-1.0).cwiseMin(1.0));
+  if (!affine(c)) return q1::inverse_map(mesh_.corners(c), point);
+  Point ref;
+  const Affine& map = affine_[c];
+  const auto centre = [&map](int e) { return map.centre[e]; };
+  const auto inverse = [&map](int r, int e) { return map.inverse_jacobian(r, e); };
+  if (!reference_in([&point](int e) { return point[e]; }, centre, inverse, [&ref](int r, double v) { ref[r] = v; }))
+    return std::nullopt;
+  return ref;
 }
 
 template <int Dim>
 auto CellLocatorOf<Dim>::hit(std::size_t c, const Point& reference) const -> Hit {
-  return {static_cast<int>(c), reference, affine_[c] ? &affine_[c]->inverse_jacobian : nullptr};
+  return {static_cast<int>(c), reference, affine(c) ? &affine_[c].inverse_jacobian : nullptr};
 }
 
 template <int Dim>
@@ -139,6 +144,9 @@ auto CellLocatorOf<Dim>::locate(const Point& point, int* hint) const -> std::opt
   if (hint && *hint >= 0 && static_cast<std::size_t>(*hint) < mesh_.num_cells())
     if (const auto ref = reference(static_cast<std::size_t>(*hint), point))
       return hit(static_cast<std::size_t>(*hint), *ref);
+  // Not-a-number coordinates (a particle gone wrong, which its solver
+  // reports) lie nowhere, and would index no bucket.
+  if (!point.allFinite()) return std::nullopt;
   const Point rel = (point - lower_).cwiseQuotient(bucket_size_);
   const double tol = 1e-9;
   std::size_t b = 0;

@@ -63,22 +63,36 @@ using Sample3 = SampleOf<3>;
 
 // The same on a parallelogram, whose inverse Jacobian d(xi, eta) / d(x, y) is
 // constant and known: no Jacobian to build and invert per point (coupled runs
-// sample the pressure at every particle every MPM step).
-template <class Nodal>
-Sample sample_affine(const std::array<int, 4>& nodes, const Nodal& u, const Eigen::Vector2d& reference,
-                     const Eigen::Matrix2d& inverse_jacobian) {
-  const double xi = reference.x(), eta = reference.y();
+// sample the pressure at every particle every MPM step). Scalars in and out,
+// u(a) the value at corner a and g(r, c) the inverse Jacobian's entries, so
+// that SIMD lanes over points (SamplerOf's batches) run the same operations
+// in the same order, and give the same numbers.
+template <class Corner, class Inverse>
+[[gnu::always_inline]] inline void sample_affine(const Corner& u, double xi, double eta, const Inverse& g,
+                                                 double& value, double& gradient_x, double& gradient_y) {
   // Scalars throughout: a 2-vector assembled from scalar stores and read
   // back whole stalls the load (no store forwarding) on every sample.
-  double value = 0, along_xi = 0, along_eta = 0;  // u and d u / d(xi, eta)
+  double sum = 0, along_xi = 0, along_eta = 0;  // u and d u / d(xi, eta)
+#pragma GCC unroll 4
   for (int a = 0; a < 4; ++a) {
-    const double ua = u[nodes[a]];
-    value += 0.25 * (1 + corner_xi[a] * xi) * (1 + corner_eta[a] * eta) * ua;
+    const double ua = u(a);
+    sum += 0.25 * (1 + corner_xi[a] * xi) * (1 + corner_eta[a] * eta) * ua;
     along_xi += 0.25 * corner_xi[a] * (1 + corner_eta[a] * eta) * ua;
     along_eta += 0.25 * corner_eta[a] * (1 + corner_xi[a] * xi) * ua;
   }
-  const Eigen::Matrix2d& g = inverse_jacobian;  // grad u = g^T d u / d(xi, eta)
-  return {value, Eigen::Vector2d(g(0, 0) * along_xi + g(1, 0) * along_eta, g(0, 1) * along_xi + g(1, 1) * along_eta)};
+  value = sum;
+  // grad u = g^T d u / d(xi, eta)
+  gradient_x = g(0, 0) * along_xi + g(1, 0) * along_eta;
+  gradient_y = g(0, 1) * along_xi + g(1, 1) * along_eta;
+}
+
+template <class Nodal, class Inverse>
+Sample sample_affine(const std::array<int, 4>& nodes, const Nodal& u, const Eigen::Vector2d& reference,
+                     const Inverse& inverse_jacobian) {
+  Sample s;
+  sample_affine([&](int a) { return u[nodes[a]]; }, reference.x(), reference.y(), inverse_jacobian, s.value,
+                s.gradient.x(), s.gradient.y());
+  return s;
 }
 
 // 2x2 Gauss rule, exact for the bilinear stiffness on parallelograms.
@@ -206,9 +220,9 @@ SampleOf<Reference::RowsAtCompileTime> sample(const Cell& x, const std::array<in
 }
 
 // The same on a parallelepiped, from its constant inverse Jacobian.
-template <class Nodal>
+template <class Nodal, class Inverse>
 Sample3 sample_affine(const std::array<int, 8>& nodes, const Nodal& u, const Eigen::Vector3d& reference,
-                      const Eigen::Matrix3d& inverse_jacobian) {
+                      const Inverse& inverse_jacobian) {
   const auto n = shape(reference);
   const auto dref = reference_gradients(reference);
   double value = 0;
