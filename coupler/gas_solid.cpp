@@ -277,20 +277,30 @@ void SolidParticipant<Dim>::set_gas_force(double fraction) {
   const int n = static_cast<int>(p.size());
   // Particles leaving the grid renumber the rest: the hints are then only stale.
   cell_hint_.resize(p.size(), -1);
-  if (force_ == GasForce::stress) {
-    auto& pore = solver_.pore_pressure();
-#pragma omp parallel for schedule(static)
-    for (int i = 0; i < n; ++i) {
-      const auto s = mapping_.sample(pressure_now_, p.x[i], &cell_hint_[i]);
-      pore[i] = s ? biot_ * s->value : 0.0;
+  using Sampler = seepage::SamplerOf<Dim>;
+  constexpr int lanes = Sampler::batch_lanes;
+  const int batches = (n + lanes - 1) / lanes;
+  // Only the field the gas force's form loads: the solver allocates each on demand.
+  const bool stress = force_ == GasForce::stress;
+  double* pore = stress ? solver_.pore_pressure().data() : nullptr;
+  mpm::Vec<Dim>* force = stress ? nullptr : solver_.external_force().data();
+#pragma omp parallel
+  {
+    typename Sampler::Batch s;
+#pragma omp for schedule(static)
+    for (int b = 0; b < batches; ++b) {
+      const int start = b * lanes, count = std::min(lanes, n - start);
+      mapping_.sample(pressure_now_, p.x[start].data(), count, &cell_hint_[start], s);
+      for (int k = 0; k < count; ++k) {
+        const auto i = static_cast<std::size_t>(start + k);
+        if (stress) {
+          pore[i] = s.found[k] != 0 ? biot_ * s.value[k] : 0.0;
+          continue;
+        }
+        const double scale = -biot_ * p.volume[i];
+        for (int d = 0; d < Dim; ++d) force[i][d] = s.found[k] != 0 ? scale * s.gradient[d][k] : 0.0;
+      }
     }
-    return;
-  }
-  auto& force = solver_.external_force();
-#pragma omp parallel for schedule(static)
-  for (int i = 0; i < n; ++i) {
-    const auto s = mapping_.sample(pressure_now_, p.x[i], &cell_hint_[i]);
-    force[i] = s ? mpm::Vec<Dim>(-biot_ * p.volume[i] * s->gradient) : mpm::Vec<Dim>::Zero();
   }
 }
 

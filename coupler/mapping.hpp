@@ -38,6 +38,11 @@ class MeshMapping {
   std::optional<Sample> sample(const Eigen::VectorXd& nodal, const Point& x, int* hint = nullptr) const {
     return sampler_.sample(nodal, x, hint);
   }
+  // The same at up to Batch's lanes of points at once (seepage::Sampler's batch).
+  using Batch = typename seepage::SamplerOf<Dim>::Batch;
+  void sample(const Eigen::VectorXd& nodal, const double* x, int count, int* hint, Batch& out) const {
+    sampler_.sample(nodal, x, count, hint, out);
+  }
   // The cell holding x, or -1.
   int cell_of(const Point& x) const { return sampler_.cell_of(x); }
 

@@ -1,5 +1,8 @@
 #include "seepage_fe/sampling.hpp"
 
+#include <cassert>
+#include <cstdint>
+
 #include "seepage_fe/q1.hpp"
 
 namespace outburst::seepage {
@@ -18,6 +21,53 @@ auto SamplerOf<Dim>::sample(const Eigen::VectorXd& nodal, const Point& x, int* h
                      ? q1::sample_affine(mesh_.cells[c], nodal, hit->reference, *hit->inverse_jacobian)
                      : q1::sample(mesh_.corners(c), mesh_.cells[c], nodal, hit->reference);
   return Value{s.value, s.gradient};
+}
+
+template <int Dim>
+void SamplerOf<Dim>::sample(const Eigen::VectorXd& nodal, const double* x, int count, int* hint, Batch& out) const {
+  assert(count <= batch_lanes);
+  const int cells = static_cast<int>(mesh_.num_cells());
+  const auto* maps = locator_.affine_maps().data();
+  const auto* nodes = mesh_.cells.data();
+  const double* u = nodal.data();
+  if constexpr (Dim == 2) {
+    // Each lane's cell map and corner values, copied one lane at a time: read
+    // by cell inside the SIMD loop, they kept it scalar (GCC 12 found no
+    // gather for them). A hint that names no cell reads cell 0, and the lane
+    // fails.
+    alignas(64) double centre[Dim][batch_lanes], inverse[Dim * Dim][batch_lanes], corner[4][batch_lanes],
+        known[batch_lanes];
+    for (int k = 0; k < count; ++k) {
+      const bool valid = hint[k] >= 0 && hint[k] < cells;
+      const std::size_t c = valid ? static_cast<std::size_t>(hint[k]) : 0;
+      known[k] = valid;
+      for (int e = 0; e < Dim; ++e) centre[e][k] = maps[c].centre[e];
+      for (int e = 0; e < Dim * Dim; ++e) inverse[e][k] = maps[c].inverse_jacobian.data()[e];
+      for (int a = 0; a < 4; ++a) corner[a][k] = u[nodes[c][a]];
+    }
+    alignas(64) double ref[Dim][batch_lanes];
+#pragma omp simd
+    for (int k = 0; k < count; ++k) {
+      const auto g = [&](int r, int e) { return inverse[r + Dim * e][k]; };
+      const bool inside = CellLocatorOf<Dim>::reference_in([&](int e) { return x[Dim * k + e]; },
+                                                           [&](int e) { return centre[e][k]; }, g,
+                                                           [&](int r, double v) { ref[r][k] = v; });
+      q1::sample_affine([&](int a) { return corner[a][k]; }, ref[0][k], ref[1][k], g, out.value[k],
+                        out.gradient[0][k], out.gradient[1][k]);
+      out.found[k] = inside ? known[k] : 0.0;
+    }
+  } else {
+    // Hexahedra one point at a time: their sums are Eigen's vector
+    // operations (q1::sample_affine), which lanes would not repeat bit for bit.
+    for (int k = 0; k < count; ++k) out.found[k] = 0;
+  }
+  for (int k = 0; k < count; ++k) {
+    if (out.found[k] != 0) continue;
+    const auto s = sample(nodal, Point(Eigen::Map<const Point>(x + Dim * k)), hint + k);
+    out.found[k] = s.has_value();
+    out.value[k] = s ? s->value : 0.0;
+    for (int d = 0; d < Dim; ++d) out.gradient[d][k] = s ? s->gradient[d] : 0.0;
+  }
 }
 
 template <int Dim>
