@@ -5,6 +5,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <fmt/format.h>
+#include <omp.h>
 
 #include "common/interval.hpp"
 
@@ -313,7 +314,9 @@ void SolidParticipant<Dim>::advance(double window) {
     const double dt = std::min(fixed_time_step_ ? *fixed_time_step_ : solver_.stable_time_step(), end - solver_.time());
     // The force at the middle of the step (explicit steps are short: the
     // pressure barely changes over one).
+    const double before = omp_get_wtime();
     set_gas_force((solver_.time() + 0.5 * dt - start) / window);
+    gas_force_seconds_ += omp_get_wtime() - before;
     const auto info = solver_.step(dt);
     last_window_.dt = info.dt;
     last_window_.removed += info.removed;

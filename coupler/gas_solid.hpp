@@ -184,6 +184,9 @@ class SolidParticipant final : public Participant {
 
   // The last advance: its last MPM step and the particles that left the grid.
   const mpm::StepInfo& last_window() const { return last_window_; }
+  // Wall time spent reading the gas pressure at the particles before each
+  // MPM step, since construction [s].
+  double gas_force_seconds() const { return gas_force_seconds_; }
 
  private:
   void set_gas_force(double fraction);
@@ -206,6 +209,7 @@ class SolidParticipant final : public Participant {
   bool sends_dilatation_;
   std::vector<double> start_volume_;  // per particle id, at the window's start
   mpm::StepInfo last_window_{0};
+  double gas_force_seconds_ = 0;
   typename mpm::Solver<Dim>::State saved_;
   Eigen::VectorXd saved_pressure_;
   mutable std::optional<typename MeshMapping<Dim>::Averages> averages_;  // of the current state

@@ -66,6 +66,34 @@ void check_run_length(scene::Table root, const coupling::CoupledSetup<Dim>& setu
   mpm::check_run_length(*root.table("mpm", "", true), setup.solid, end_time);
 }
 
+// Where a coupled run's wall time goes, from the solvers' and the
+// coupling's own clocks: MPM steps, the gas force read at the particles
+// before each, the rest of the solid's windows (its transfers to the seepage
+// cells, saving and restoring), the seepage's windows, the coupling's
+// exchanges and acceleration, and what is left (output, logs).
+template <int Dim>
+struct RunTimes {
+  double mpm, gas_force, solid = 0, seepage = 0, coupler = 0;
+  explicit RunTimes(const coupling::CoupledModel<Dim>& model)
+      : mpm(model.solid().step_times().total()), gas_force(model.solid_side().gas_force_seconds()) {
+    for (const auto& r : model.coupling().records()) {
+      solid += r.second_seconds;
+      seepage += r.first_seconds;
+      coupler += r.coupler_seconds;
+    }
+  }
+  // "MPM steps 76 %, ... of 20.9 s": what was spent after `start`, of `wall` seconds.
+  std::string since(const RunTimes& start, double wall) const {
+    const double steps = mpm - start.mpm, gas = gas_force - start.gas_force, solid_all = solid - start.solid;
+    const double rest = wall - solid_all - (seepage - start.seepage) - (coupler - start.coupler);
+    const auto share = [wall](double part) { return wall > 0 ? 100 * part / wall : 0.0; };
+    return fmt::format("MPM steps {:.0f} %, gas force at the particles {:.0f} %, the solid's other work {:.0f} %, "
+                       "seepage {:.0f} %, coupling {:.0f} %, output and the rest {:.0f} % of {:.3g} s",
+                       share(steps), share(gas), share(solid_all - steps - gas), share(seepage - start.seepage),
+                       share(coupler - start.coupler), share(rest), wall);
+  }
+};
+
 // The run of a coupled scene of dimension Dim (2: plane strain, 3: 3D).
 template <int Dim>
 int run_in(const RunOptions& options, scene::Document& doc) {
@@ -166,6 +194,7 @@ int run_in(const RunOptions& options, scene::Document& doc) {
   } else {
     driver.snapshot();
   }
+  const RunTimes times_from(model);
   const RunEnd end = loop.run(driver, "outburst", options.show_progress());
   if (end == RunEnd::stopped) return report_stop(coupler.time(), directory);
   solid_out.finish();
@@ -175,6 +204,7 @@ int run_in(const RunOptions& options, scene::Document& doc) {
                  loop.peak_kinetic_energy());
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   spdlog::info("MPM steps' wall time: {}", mpm::describe(solid.step_times()));
+  spdlog::info("the run's wall time: {}", RunTimes(model).since(times_from, wall));
   spdlog::info("done: {} windows, {} sub-iterations, {} MPM steps, {:.3g} s wall; gas released {:.4g} {}, "
                "{} particles left the grid",
                coupler.records().size(), driver.iterations, solid.steps(), wall, seepage_solver.balance().total_outflow(),

@@ -67,6 +67,7 @@ class CoupledModel {
   const CouplingSetup& coupling_setup() const { return setup_.coupling; }
   seepage::SolverOf<Dim>& seepage() { return *seepage_; }
   mpm::Solver<Dim>& solid() { return *solid_; }
+  const mpm::Solver<Dim>& solid() const { return *solid_; }
   const MeshMapping<Dim>& mapping() const { return *mapping_; }
   const SeepageParticipant<Dim>& seepage_side() const { return *seepage_side_; }
   const SolidParticipant<Dim>& solid_side() const { return *solid_side_; }

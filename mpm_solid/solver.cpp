@@ -1174,7 +1174,7 @@ void Solver<Dim>::step_kernel(double dt) {
 }
 
 std::string describe(const StepTimes& t) {
-  const double total = t.map + t.grid + t.stress + t.motion;
+  const double total = t.total();
   const auto share = [total](double part) { return total > 0 ? 100 * part / total : 0.0; };
   return fmt::format("particles to grid {:.0f} %, grid {:.0f} %, stresses and forces {:.0f} %, grid to particles "
                      "{:.0f} % of {:.3g} s",

@@ -194,6 +194,7 @@ struct StepTimes {
   double grid = 0;    // the grid's velocities and update, walls, platens
   double stress = 0;  // velocity gradients, the stress update, nodal forces
   double motion = 0;  // grid to particles: velocities, positions, the census
+  double total() const { return map + grid + stress + motion; }
 };
 // "particles to grid 18 %, grid 9 %, ... of 93.1 s".
 std::string describe(const StepTimes& t);
