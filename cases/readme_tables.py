@@ -475,6 +475,7 @@ block("mpm benchmark settle lanes", "mpm_solid/benchmark/compare-63e0ffd-de26bb6
 block("outburst cost settle lanes", "cases/outburst/benchmark/outburst-benchmark-settle-lanes.csv")(outburst_cost)
 block("mpm benchmark active walls", "mpm_solid/benchmark/compare-63e0ffd-877286d-98ecb4e.csv")(mpm_benchmark_builds)
 block("outburst cost active walls", "cases/outburst/benchmark/outburst-benchmark-active-walls.csv")(outburst_cost)
+block("outburst cost gas lanes", "cases/outburst/benchmark/outburst-benchmark-gas-lanes.csv")(outburst_cost)
 
 
 @block("mpm benchmark", "mpm_solid/benchmark/mpm-benchmark.csv")
