@@ -219,20 +219,40 @@ SampleOf<Reference::RowsAtCompileTime> sample(const Cell& x, const std::array<in
   return s;
 }
 
-// The same on a parallelepiped, from its constant inverse Jacobian.
+// The same on a parallelepiped, from its constant inverse Jacobian; scalars
+// in and out as on the parallelogram, for SIMD lanes over points.
+template <class Corner, class Inverse>
+[[gnu::always_inline]] inline void sample_affine(const Corner& u, double xi, double eta, double zeta,
+                                                 const Inverse& g, double& value, double& gradient_x,
+                                                 double& gradient_y, double& gradient_z) {
+  const double r[3] = {xi, eta, zeta};
+  double sum = 0, along[3] = {0, 0, 0};  // u and d u / d(xi, eta, zeta)
+#pragma GCC unroll 8
+  for (int a = 0; a < 8; ++a) {
+    const double ua = u(a);
+    double f[3];
+#pragma GCC unroll 3
+    for (int d = 0; d < 3; ++d) f[d] = 1 + hex_corner[a][d] * r[d];
+    sum += 0.125 * f[0] * f[1] * f[2] * ua;
+    along[0] += 0.125 * (hex_corner[a][0] * f[1] * f[2]) * ua;
+    along[1] += 0.125 * (f[0] * hex_corner[a][1] * f[2]) * ua;
+    along[2] += 0.125 * (f[0] * f[1] * hex_corner[a][2]) * ua;
+  }
+  value = sum;
+  // grad u = g^T d u / d(xi, eta, zeta)
+  const auto column = [&](int c) { return g(0, c) * along[0] + g(1, c) * along[1] + g(2, c) * along[2]; };
+  gradient_x = column(0);
+  gradient_y = column(1);
+  gradient_z = column(2);
+}
+
 template <class Nodal, class Inverse>
 Sample3 sample_affine(const std::array<int, 8>& nodes, const Nodal& u, const Eigen::Vector3d& reference,
                       const Inverse& inverse_jacobian) {
-  const auto n = shape(reference);
-  const auto dref = reference_gradients(reference);
-  double value = 0;
-  Eigen::Vector3d along = Eigen::Vector3d::Zero();  // d u / d(xi, eta, zeta)
-  for (int a = 0; a < 8; ++a) {
-    const double ua = u[nodes[a]];
-    value += n[a] * ua;
-    along += dref[a] * ua;
-  }
-  return {value, inverse_jacobian.transpose() * along};
+  Sample3 s;
+  sample_affine([&](int a) { return u[nodes[a]]; }, reference.x(), reference.y(), reference.z(), inverse_jacobian,
+                s.value, s.gradient.x(), s.gradient.y(), s.gradient.z());
+  return s;
 }
 
 // 2x2x2 Gauss points, exact for the trilinear stiffness on parallelepipeds.

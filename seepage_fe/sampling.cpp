@@ -30,36 +30,35 @@ void SamplerOf<Dim>::sample(const Eigen::VectorXd& nodal, const double* x, int c
   const auto* maps = locator_.affine_maps().data();
   const auto* nodes = mesh_.cells.data();
   const double* u = nodal.data();
-  if constexpr (Dim == 2) {
-    // Each lane's cell map and corner values, copied one lane at a time: read
-    // by cell inside the SIMD loop, they kept it scalar (GCC 12 found no
-    // gather for them). A hint that names no cell reads cell 0, and the lane
-    // fails.
-    alignas(64) double centre[Dim][batch_lanes], inverse[Dim * Dim][batch_lanes], corner[4][batch_lanes],
-        known[batch_lanes];
-    for (int k = 0; k < count; ++k) {
-      const bool valid = hint[k] >= 0 && hint[k] < cells;
-      const std::size_t c = valid ? static_cast<std::size_t>(hint[k]) : 0;
-      known[k] = valid;
-      for (int e = 0; e < Dim; ++e) centre[e][k] = maps[c].centre[e];
-      for (int e = 0; e < Dim * Dim; ++e) inverse[e][k] = maps[c].inverse_jacobian.data()[e];
-      for (int a = 0; a < 4; ++a) corner[a][k] = u[nodes[c][a]];
-    }
-    alignas(64) double ref[Dim][batch_lanes];
+  constexpr int corners = MeshOf<Dim>::cell_corners;
+  // Each lane's cell map and corner values, copied one lane at a time: read
+  // by cell inside the SIMD loop, they kept it scalar (GCC 12 found no
+  // gather for them). A hint that names no cell reads cell 0, and the lane
+  // fails.
+  alignas(64) double centre[Dim][batch_lanes], inverse[Dim * Dim][batch_lanes], corner[corners][batch_lanes],
+      known[batch_lanes];
+  for (int k = 0; k < count; ++k) {
+    const bool valid = hint[k] >= 0 && hint[k] < cells;
+    const std::size_t c = valid ? static_cast<std::size_t>(hint[k]) : 0;
+    known[k] = valid;
+    for (int e = 0; e < Dim; ++e) centre[e][k] = maps[c].centre[e];
+    for (int e = 0; e < Dim * Dim; ++e) inverse[e][k] = maps[c].inverse_jacobian.data()[e];
+    for (int a = 0; a < corners; ++a) corner[a][k] = u[nodes[c][a]];
+  }
+  alignas(64) double ref[Dim][batch_lanes];
 #pragma omp simd
-    for (int k = 0; k < count; ++k) {
-      const auto g = [&](int r, int e) { return inverse[r + Dim * e][k]; };
-      const bool inside = CellLocatorOf<Dim>::reference_in([&](int e) { return x[Dim * k + e]; },
-                                                           [&](int e) { return centre[e][k]; }, g,
-                                                           [&](int r, double v) { ref[r][k] = v; });
-      q1::sample_affine([&](int a) { return corner[a][k]; }, ref[0][k], ref[1][k], g, out.value[k],
-                        out.gradient[0][k], out.gradient[1][k]);
-      out.found[k] = inside ? known[k] : 0.0;
-    }
-  } else {
-    // Hexahedra one point at a time: their sums are Eigen's vector
-    // operations (q1::sample_affine), which lanes would not repeat bit for bit.
-    for (int k = 0; k < count; ++k) out.found[k] = 0;
+  for (int k = 0; k < count; ++k) {
+    const auto g = [&](int r, int e) { return inverse[r + Dim * e][k]; };
+    const auto at_corner = [&](int a) { return corner[a][k]; };
+    const bool inside = CellLocatorOf<Dim>::reference_in([&](int e) { return x[Dim * k + e]; },
+                                                         [&](int e) { return centre[e][k]; }, g,
+                                                         [&](int r, double v) { ref[r][k] = v; });
+    if constexpr (Dim == 2)
+      q1::sample_affine(at_corner, ref[0][k], ref[1][k], g, out.value[k], out.gradient[0][k], out.gradient[1][k]);
+    else
+      q1::sample_affine(at_corner, ref[0][k], ref[1][k], ref[2][k], g, out.value[k], out.gradient[0][k],
+                        out.gradient[1][k], out.gradient[2][k]);
+    out.found[k] = inside ? known[k] : 0.0;
   }
   for (int k = 0; k < count; ++k) {
     if (out.found[k] != 0) continue;

@@ -295,3 +295,15 @@ TEST_CASE("CHOLMOD factorises 3D meshes supernodally at every size, plane ones s
   CHECK(box.factorisation().name() == "supernodal/nesdis");
   CHECK(plane.factorisation().name() == "simplicial/amd");
 }
+
+TEST_CASE("a batch of points in 3D sampled over SIMD lanes gives each point its own sample, bit for bit",
+          "[seepage][3d][sampling]") {
+  // Boxes of parallelepipeds (the lanes') and of distorted cells (the
+  // one-point search's), spanning [0, 1.5] x [0, 1] x [0, 1.2].
+  seepage::BoxMeshSpec spec;
+  spec.size = {1.5, 1.0, 1.2};
+  spec.cells = {3, 3, 3};
+  spec.grading = {3.0, 1.0, 0.4};
+  for (const auto& mesh : {seepage::make_box_mesh(spec), distorted_box()})
+    check_batch_samples(mesh, Eigen::Vector3d(-0.2, -0.1, -0.1), Eigen::Vector3d(1.7, 1.1, 1.3));
+}

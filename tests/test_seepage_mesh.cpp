@@ -1,6 +1,5 @@
 #include <catch2/catch.hpp>
 
-#include <cstdint>
 #include <filesystem>
 #include <fstream>
 
@@ -8,6 +7,7 @@
 #include "seepage_fe/sampling.hpp"
 #include "seepage_fe/mesh.hpp"
 #include "seepage_fe/q1.hpp"
+#include "seepage_fixtures.hpp"
 
 using namespace outburst::seepage;
 namespace fs = std::filesystem;
@@ -298,57 +298,7 @@ TEST_CASE("a field sampled in a parallelogram by its constant inverse Jacobian e
 TEST_CASE("a batch of points sampled over SIMD lanes gives each point its own sample, bit for bit",
           "[seepage][mesh]") {
   // Parallelograms, which the lanes take, and moved cells, which they leave
-  // to the one-point search.
+  // to the one-point search. The mesh spans x in [0, 4.6], y in [0, 2].
   const Mesh m = sheared_mesh_with_moved_nodes();
-  const Sampler sampler(m);
-  Eigen::VectorXd u(static_cast<Eigen::Index>(m.num_nodes()));
-  for (std::size_t k = 0; k < m.num_nodes(); ++k)
-    u[static_cast<Eigen::Index>(k)] = std::sin(3 * m.nodes[k].x()) + m.nodes[k].y() * m.nodes[k].y();
-  const int cells = static_cast<int>(m.num_cells());
-  std::vector<double> x;
-  std::vector<int> hints;
-  std::uint32_t state = 12345;
-  const auto uniform = [&state] {  // in [0, 1): a fixed sequence on every platform
-    state = state * 1664525u + 1013904223u;
-    return (state >> 8) * (1.0 / 16777216.0);
-  };
-  for (int k = 0; k < 300; ++k) {
-    // The mesh spans x in [0, 4.6], y in [0, 2]; a margin around it.
-    x.push_back(-0.3 + 5.2 * uniform());
-    x.push_back(-0.2 + 2.4 * uniform());
-    const Eigen::Vector2d point(x[x.size() - 2], x.back());
-    // The cell that holds it (the lanes' case), none, another, or no cell at all.
-    switch (k % 4) {
-      case 0: hints.push_back(sampler.cell_of(point)); break;
-      case 1: hints.push_back(-1); break;
-      case 2: hints.push_back(static_cast<int>(uniform() * cells)); break;
-      default: hints.push_back(k % 8 == 3 ? cells + 5 : sampler.cell_of(point)); break;
-    }
-  }
-  constexpr int lanes = Sampler::batch_lanes;
-  int from_lanes = 0, outside = 0;
-  Sampler::Batch batch;
-  // Full batches and a short one.
-  for (int start = 0; start < 300; start += lanes) {
-    const int count = std::min(lanes, 300 - start);
-    std::vector<int> alone(hints.begin() + start, hints.begin() + start + count);
-    sampler.sample(u, x.data() + 2 * start, count, hints.data() + start, batch);
-    for (int k = 0; k < count; ++k) {
-      const Eigen::Vector2d point(x[2 * (start + k)], x[2 * (start + k) + 1]);
-      const int given = alone[k];
-      const auto expected = sampler.sample(u, point, &alone[k]);
-      CHECK(hints[start + k] == alone[k]);
-      REQUIRE((batch.found[k] != 0) == expected.has_value());
-      if (!expected) {
-        ++outside;
-        continue;
-      }
-      from_lanes += given == alone[k];
-      CHECK(batch.value[k] == expected->value);
-      CHECK(batch.gradient[0][k] == expected->gradient.x());
-      CHECK(batch.gradient[1][k] == expected->gradient.y());
-    }
-  }
-  CHECK(from_lanes > 50);
-  CHECK(outside > 10);
+  outburst::testing::check_batch_samples(m, Eigen::Vector2d(-0.3, -0.2), Eigen::Vector2d(4.9, 2.2));
 }
