@@ -278,16 +278,18 @@ void SolidParticipant<Dim>::set_gas_force(double fraction) {
   const int n = static_cast<int>(p.size());
   // Particles leaving the grid renumber the rest: the hints are then only stale.
   cell_hint_.resize(p.size(), -1);
-  using Sampler = seepage::SamplerOf<Dim>;
-  constexpr int lanes = Sampler::batch_lanes;
+  using Batch = typename MeshMapping<Dim>::Batch;
+  constexpr int lanes = MeshMapping<Dim>::batch_lanes;
   const int batches = (n + lanes - 1) / lanes;
+  // The batch reads the positions as Dim doubles a particle, back to back.
+  static_assert(sizeof(mpm::Vec<Dim>) == Dim * sizeof(double));
   // Only the field the gas force's form loads: the solver allocates each on demand.
   const bool stress = force_ == GasForce::stress;
   double* pore = stress ? solver_.pore_pressure().data() : nullptr;
   mpm::Vec<Dim>* force = stress ? nullptr : solver_.external_force().data();
 #pragma omp parallel
   {
-    typename Sampler::Batch s;
+    Batch s;
 #pragma omp for schedule(static)
     for (int b = 0; b < batches; ++b) {
       const int start = b * lanes, count = std::min(lanes, n - start);

@@ -66,11 +66,13 @@ void check_run_length(scene::Table root, const coupling::CoupledSetup<Dim>& setu
   mpm::check_run_length(*root.table("mpm", "", true), setup.solid, end_time);
 }
 
-// Where a coupled run's wall time goes, from the solvers' and the
-// coupling's own clocks: MPM steps, the gas force read at the particles
-// before each, the rest of the solid's windows (its transfers to the seepage
-// cells, saving and restoring), the seepage's windows, the coupling's
-// exchanges and acceleration, and what is left (output, logs).
+// Where a coupled run's wall time goes from the start of its run loop (after
+// settling, after a restart), by the solvers' and the coupling's own clocks:
+// MPM steps; the gas force read at the particles before each; the rest of
+// the solid's windows (step sizes, escaped particles); the seepage's
+// windows; the exchanges and acceleration (the solid's cell averages, made
+// when the coupling reads them, among them); and what is left: output, the
+// participants' saving and restoring, logs.
 template <int Dim>
 struct RunTimes {
   double mpm, gas_force, solid = 0, seepage = 0, coupler = 0;
@@ -87,8 +89,9 @@ struct RunTimes {
     const double steps = mpm - start.mpm, gas = gas_force - start.gas_force, solid_all = solid - start.solid;
     const double rest = wall - solid_all - (seepage - start.seepage) - (coupler - start.coupler);
     const auto share = [wall](double part) { return wall > 0 ? 100 * part / wall : 0.0; };
-    return fmt::format("MPM steps {:.0f} %, gas force at the particles {:.0f} %, the solid's other work {:.0f} %, "
-                       "seepage {:.0f} %, coupling {:.0f} %, output and the rest {:.0f} % of {:.3g} s",
+    return fmt::format("MPM steps {:.0f} %, gas force at the particles {:.0f} %, the solid's step bookkeeping "
+                       "{:.0f} %, seepage {:.0f} %, exchanges and acceleration {:.0f} %, output and the rest {:.0f} % "
+                       "of {:.3g} s",
                        share(steps), share(gas), share(solid_all - steps - gas), share(seepage - start.seepage),
                        share(coupler - start.coupler), share(rest), wall);
   }

@@ -38,7 +38,8 @@ class MeshMapping {
   std::optional<Sample> sample(const Eigen::VectorXd& nodal, const Point& x, int* hint = nullptr) const {
     return sampler_.sample(nodal, x, hint);
   }
-  // The same at up to Batch's lanes of points at once (seepage::Sampler's batch).
+  // The same at up to batch_lanes points at once (seepage::Sampler's batch).
+  static constexpr int batch_lanes = seepage::SamplerOf<Dim>::batch_lanes;
   using Batch = typename seepage::SamplerOf<Dim>::Batch;
   void sample(const Eigen::VectorXd& nodal, const double* x, int count, int* hint, Batch& out) const {
     sampler_.sample(nodal, x, count, hint, out);

@@ -53,8 +53,9 @@ class CellLocatorOf {
   // and inverse(r, c) its map's entries, each clamped into [-1, 1] and handed
   // to ref(r, value); whether x lies in the cell to 1e-9 of its size
   // (q1::inverse_map's acceptance: a point on an edge two cells share is
-  // found). Written out for one point, so that SIMD lanes over points give
-  // the numbers a point alone gets.
+  // found). Written out for one point, so that SIMD lanes over points run
+  // the same operations (tests check their numbers against a point's alone,
+  // to the bit).
   template <class X, class Centre, class Inverse, class Ref>
   [[gnu::always_inline]] static bool reference_in(const X& x, const Centre& centre, const Inverse& inverse,
                                                   const Ref& ref) {

@@ -66,7 +66,7 @@ using Sample3 = SampleOf<3>;
 // sample the pressure at every particle every MPM step). Scalars in and out,
 // u(a) the value at corner a and g(r, c) the inverse Jacobian's entries, so
 // that SIMD lanes over points (SamplerOf's batches) run the same operations
-// in the same order, and give the same numbers.
+// in the same order (tests check the numbers are the same).
 template <class Corner, class Inverse>
 [[gnu::always_inline]] inline void sample_affine(const Corner& u, double xi, double eta, const Inverse& g,
                                                  double& value, double& gradient_x, double& gradient_y) {

@@ -1,7 +1,8 @@
 #include "seepage_fe/sampling.hpp"
 
-#include <cassert>
-#include <cstdint>
+#include <stdexcept>
+
+#include <fmt/format.h>
 
 #include "seepage_fe/q1.hpp"
 
@@ -25,7 +26,9 @@ auto SamplerOf<Dim>::sample(const Eigen::VectorXd& nodal, const Point& x, int* h
 
 template <int Dim>
 void SamplerOf<Dim>::sample(const Eigen::VectorXd& nodal, const double* x, int count, int* hint, Batch& out) const {
-  assert(count <= batch_lanes);
+  if (count < 0 || count > batch_lanes)
+    throw std::invalid_argument(fmt::format("seepage sampler: a batch of {} points, expected 0 to {}", count,
+                                            batch_lanes));
   const int cells = static_cast<int>(mesh_.num_cells());
   const auto* maps = locator_.affine_maps().data();
   const auto* nodes = mesh_.cells.data();
@@ -60,8 +63,10 @@ void SamplerOf<Dim>::sample(const Eigen::VectorXd& nodal, const double* x, int c
                         out.gradient[1][k], out.gradient[2][k]);
     out.found[k] = inside ? known[k] : 0.0;
   }
+  out.by_lanes = count;
   for (int k = 0; k < count; ++k) {
     if (out.found[k] != 0) continue;
+    --out.by_lanes;
     const auto s = sample(nodal, Point(Eigen::Map<const Point>(x + Dim * k)), hint + k);
     out.found[k] = s.has_value();
     out.value[k] = s ? s->value : 0.0;

@@ -38,17 +38,20 @@ class SamplerOf {
   // one costs one test).
   std::optional<Value> sample(const Eigen::VectorXd& nodal, const Point& x, int* hint = nullptr) const;
 
-  // The same at `count` points at once (at most batch_lanes; point k's
-  // coordinates x[Dim k ..], its hint hint[k]): SIMD lanes over the points
-  // still in their hinted parallelogram (parallelepiped), the others one by
-  // one. Each point's numbers are those of the call above, which coupled
-  // runs would otherwise make for every particle every step, a tenth of the
-  // run to rest's time.
+  // The same at `count` points at once, at most batch_lanes: point k's
+  // coordinates are x[Dim k ..], its hint hint[k] (every point has one,
+  // updated as above). SIMD lanes take the points still in their hinted
+  // parallelogram (parallelepiped), the call above the others. The lanes run
+  // the call's formula (CellLocator::reference_in, q1::sample_affine), and
+  // tests check that each point gets its numbers to the bit: coupled runs
+  // read the pressure at every particle every MPM step, which the call
+  // above took a tenth of the run to rest's time for.
   static constexpr int batch_lanes = 16;
   struct Batch {
     alignas(64) double value[batch_lanes];
     alignas(64) double gradient[Dim][batch_lanes];
     alignas(64) double found[batch_lanes];  // 1 inside the mesh, 0 outside (value and gradient 0)
+    int by_lanes;  // points the lanes took (the others went one by one)
   };
   void sample(const Eigen::VectorXd& nodal, const double* x, int count, int* hint, Batch& out) const;
   // The cell holding x, or -1.

@@ -298,12 +298,20 @@ TEST_CASE("CHOLMOD factorises 3D meshes supernodally at every size, plane ones s
 
 TEST_CASE("a batch of points in 3D sampled over SIMD lanes gives each point its own sample, bit for bit",
           "[seepage][3d][sampling]") {
-  // Boxes of parallelepipeds (the lanes') and of distorted cells (the
-  // one-point search's), spanning [0, 1.5] x [0, 1] x [0, 1.2].
+  // A graded box and the same sheared (parallelepipeds with full inverse
+  // Jacobians), which the lanes take, and a distorted one, which they leave
+  // to the one-point search.
   seepage::BoxMeshSpec spec;
   spec.size = {1.5, 1.0, 1.2};
   spec.cells = {3, 3, 3};
   spec.grading = {3.0, 1.0, 0.4};
-  for (const auto& mesh : {seepage::make_box_mesh(spec), distorted_box()})
-    check_batch_samples(mesh, Eigen::Vector3d(-0.2, -0.1, -0.1), Eigen::Vector3d(1.7, 1.1, 1.3));
+  const Eigen::Vector3d lower(-0.2, -0.1, -0.1);
+  check_batch_samples(seepage::make_box_mesh(spec), lower, Eigen::Vector3d(1.7, 1.1, 1.3), true);
+  auto sheared = seepage::make_box_mesh(spec);
+  for (auto& x : sheared.nodes) {
+    x.x() += 0.3 * x.y() + 0.2 * x.z();
+    x.y() += 0.1 * x.z();
+  }
+  check_batch_samples(sheared, lower, Eigen::Vector3d(2.2, 1.3, 1.3), true);
+  check_batch_samples(distorted_box(), lower, Eigen::Vector3d(1.7, 1.1, 1.3), false);
 }
