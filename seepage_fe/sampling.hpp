@@ -43,9 +43,9 @@ class SamplerOf {
   // updated as above). SIMD lanes take the points still in their hinted
   // parallelogram (parallelepiped), the call above the others. The lanes run
   // the call's formula (CellLocator::reference_in, q1::sample_affine), and
-  // tests check that each point gets its numbers to the bit: coupled runs
-  // read the pressure at every particle every MPM step, which the call
-  // above took a tenth of the run to rest's time for.
+  // tests check that each point gets its numbers to the bit. Coupled runs
+  // read the pressure at every particle every MPM step: one point at a time,
+  // that took a tenth of the run to rest's time.
   static constexpr int batch_lanes = 16;
   struct Batch {
     alignas(64) double value[batch_lanes];
