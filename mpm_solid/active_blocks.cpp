@@ -16,6 +16,7 @@ ActiveBlocks<Dim>::ActiveBlocks(const Grid<Dim>& grid, const std::array<bool, 2 
   if constexpr (Dim == 3) strides_[1] = blocks_[0] * blocks_[1];
   marks_.assign(static_cast<std::size_t>(threads), std::vector<std::uint8_t>(count, 0));
   active_.assign(count, 0);
+  was_active_.assign(count, 0);
   const int g = Grid<Dim>::ghost;
   for (int side = 0; side < 2 * Dim; ++side) {
     if (!mirrored[side]) continue;
@@ -26,6 +27,7 @@ ActiveBlocks<Dim>::ActiveBlocks(const Grid<Dim>& grid, const std::array<bool, 2 
 
 template <int Dim>
 void ActiveBlocks<Dim>::collect() {
+  was_active_.swap(active_);
   std::fill(active_.begin(), active_.end(), 0);
   for (auto& m : marks_)
     for (std::size_t b = 0; b < m.size(); ++b) {
@@ -39,50 +41,73 @@ void ActiveBlocks<Dim>::collect() {
     std::array<int, Dim> b{};
     // Over the blocks of the strip's first layer; each stands for its column
     // across the strip.
-    for (std::size_t flat = 0; flat < active_.size(); ++flat) {
+    std::size_t layer = 1;
+    for (int d = 0; d < Dim; ++d)
+      if (d != s.axis) layer *= static_cast<std::size_t>(blocks_[d]);
+    for (std::size_t flat = 0; flat < layer; ++flat) {
       std::size_t rest = flat;
       for (int d = 0; d < Dim; ++d) {
+        if (d == s.axis) continue;
         b[d] = static_cast<int>(rest % static_cast<std::size_t>(blocks_[d]));
         rest /= static_cast<std::size_t>(blocks_[d]);
       }
-      if (b[s.axis] != s.from / size) continue;
       bool any = false;
       for (b[s.axis] = s.from / size; b[s.axis] <= s.to / size; ++b[s.axis]) any = any || active_[block_index(b)];
       if (!any) continue;
       for (b[s.axis] = s.from / size; b[s.axis] <= s.to / size; ++b[s.axis]) active_[block_index(b)] = 1;
     }
   }
-  runs_.clear();
-  active_nodes_ = 0;
-  // Rows of nodes along x: j in 2D, (j, k) in 3D.
-  const int layers = Dim == 2 ? 1 : nodes_[Dim - 1];
+  active_nodes_ = runs_of([this](std::size_t b) { return active_[b] != 0; }, runs_);
+  const auto dropped = [this](std::size_t b) { return was_active_[b] != 0 && active_[b] == 0; };
+  bool any = false;  // mostly none: the runs' walk over the rows is spared
+  for (std::size_t b = 0; b < active_.size(); ++b) any = any || dropped(b);
+  if (any)
+    runs_of(dropped, dropped_);
+  else
+    dropped_.clear();
+}
+
+template <int Dim>
+template <class Pick>
+std::size_t ActiveBlocks<Dim>::runs_of(Pick&& picked, std::vector<Run>& runs) const {
+  runs.clear();
+  std::size_t nodes = 0;
+  // Runs stay within a row of nodes along x: merged across rows, a body as
+  // wide as the grid would make one run of every node, and the passes,
+  // parallel over runs, one thread's work. The rows of a row of blocks share
+  // one pattern of runs, [from, from + count) along x.
+  std::vector<std::array<int, 2>> pattern;
+  const int layers = Dim == 2 ? 1 : nodes_[Dim - 1];  // of nodes across z
   for (int k = 0; k < layers; ++k)
-    for (int j = 0; j < nodes_[1]; ++j) {
-      const std::size_t row =
-          (static_cast<std::size_t>(k) * static_cast<std::size_t>(nodes_[1]) + static_cast<std::size_t>(j)) *
-          static_cast<std::size_t>(nodes_[0]);
+    for (int by = 0; by < blocks_[1]; ++by) {
       std::array<int, Dim> b{};
-      b[1] = j / size;
+      b[1] = by;
       if constexpr (Dim == 3) b[2] = k / size;
+      pattern.clear();
       for (b[0] = 0; b[0] < blocks_[0]; ++b[0]) {
-        if (!active_[block_index(b)]) continue;
+        if (!picked(block_index(b))) continue;
         const int from = b[0] * size, count = std::min(nodes_[0], from + size) - from;
-        // Runs stay within a row: merged across rows, a body as wide as the
-        // grid would make one run of every node, and the passes, parallel
-        // over runs, one thread's work.
-        if (from > 0 && !runs_.empty() &&
-            runs_.back().first + static_cast<std::size_t>(runs_.back().count) == row + from)
-          runs_.back().count += count;
+        if (!pattern.empty() && pattern.back()[0] + pattern.back()[1] == from)
+          pattern.back()[1] += count;
         else
-          runs_.push_back({row + static_cast<std::size_t>(from), count});
-        active_nodes_ += static_cast<std::size_t>(count);
+          pattern.push_back({from, count});
+      }
+      for (int j = by * size; j < std::min(nodes_[1], (by + 1) * size); ++j) {
+        const std::size_t row =
+            (static_cast<std::size_t>(k) * static_cast<std::size_t>(nodes_[1]) + static_cast<std::size_t>(j)) *
+            static_cast<std::size_t>(nodes_[0]);
+        for (const auto& [from, count] : pattern) {
+          runs.push_back({row + static_cast<std::size_t>(from), count});
+          nodes += static_cast<std::size_t>(count);
+        }
       }
     }
+  return nodes;
 }
 
 template <int Dim>
 std::size_t ActiveBlocks<Dim>::bytes() const {
-  std::size_t b = active_.capacity() + runs_.capacity() * sizeof(Run);
+  std::size_t b = active_.capacity() + was_active_.capacity() + (runs_.capacity() + dropped_.capacity()) * sizeof(Run);
   for (const auto& m : marks_) b += m.capacity();
   return b;
 }

@@ -71,10 +71,16 @@ class ActiveBlocks {
   // Contiguous runs of active nodes, in increasing node order.
   using Run = NodeRun;
   const std::vector<Run>& runs() const { return runs_; }
+  // The same of the nodes the last collect() dropped (active before it, no
+  // longer): what was left there is to be cleared.
+  const std::vector<Run>& dropped() const { return dropped_; }
   std::size_t active_nodes() const { return active_nodes_; }
   std::size_t bytes() const;
 
  private:
+  // The runs of the nodes of the blocks picked(flat block index) picks; their count.
+  template <class Pick>
+  std::size_t runs_of(Pick&& picked, std::vector<Run>& runs) const;
   std::size_t block_index(const std::array<int, Dim>& b) const {
     std::size_t flat = 0;
     for (int d = Dim - 1; d >= 0; --d)
@@ -91,8 +97,8 @@ class ActiveBlocks {
   };
   std::vector<Strip> strips_;
   std::vector<std::vector<std::uint8_t>> marks_;  // per thread, per block
-  std::vector<std::uint8_t> active_;
-  std::vector<Run> runs_;
+  std::vector<std::uint8_t> active_, was_active_;  // per block: now, before the last collect
+  std::vector<Run> runs_, dropped_;
   std::size_t active_nodes_ = 0;
 };
 

@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstddef>
 #include <vector>
 
 #include <Eigen/Core>
@@ -33,6 +34,12 @@ struct Grid {
     std::size_t n = 1;
     for (int d = 0; d < Dim; ++d) n *= static_cast<std::size_t>(nodes_along(d));
     return n;
+  }
+  // How far apart in the flat index two nodes neighbouring along axis d lie.
+  std::ptrdiff_t stride(int d) const {
+    std::ptrdiff_t s = 1;
+    for (int e = 0; e < d; ++e) s *= nodes_along(e);
+    return s;
   }
   // Flat index of the node with integer grid coordinates i.
   std::size_t index(const std::array<int, Dim>& i) const {

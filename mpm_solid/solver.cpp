@@ -439,12 +439,12 @@ template <class Shape, bool Apic>
 void Solver<Dim>::scatter_mass_momentum() {
   const auto& p = particles_;
   const int n = static_cast<int>(p.size());
-  clear_grid();
   Scatter<double> masses{thread_mass_, mass_, active_.runs()};
   Scatter<Vec<Dim>> momenta{thread_vector_, momentum_, active_.runs()};
   long outside = 0;
 #pragma omp parallel num_threads(threads_) reduction(+ : outside)
   {
+    clear_sums();  // over the runs of the mapping before, ending at a barrier
     double* m = masses.buffer(omp_get_thread_num()).data();
     Vec<Dim>* mv = momenta.buffer(omp_get_thread_num()).data();
     std::uint8_t* reached = active_.marks(omp_get_thread_num());
@@ -495,6 +495,7 @@ void Solver<Dim>::scatter_mass_momentum() {
     }
   }
   active_.collect();
+  clear_dropped();
   if (outside > 0)
     throw SimulationError(fmt::format("mpm: step {}: {} particles lie beyond the grid's ghost nodes", steps_ + 1,
                                       outside));
@@ -521,17 +522,27 @@ std::size_t Solver<Dim>::stray_nodal_values() const {
   return stray;
 }
 
+// The grid's velocities are written at every active node before they are
+// read: they are cleared only where the mapping no longer reaches
+// (clear_dropped), and the sums here.
 template <int Dim>
-void Solver<Dim>::clear_grid() {
+void Solver<Dim>::clear_sums() {
   const Runs& runs = active_.runs();
   const int n = static_cast<int>(runs.size());
-#pragma omp parallel for schedule(static)
+#pragma omp for schedule(static)
   for (int r = 0; r < n; ++r) {
     const auto [first, count] = runs[static_cast<std::size_t>(r)];
     const auto from = static_cast<std::ptrdiff_t>(first);
     std::fill_n(mass_.begin() + from, count, 0.0);
-    for (auto* field : {&momentum_, &force_, &velocity_, &velocity_new_})
-      std::fill_n(field->begin() + from, count, Vec<Dim>::Zero());
+    for (auto* field : {&momentum_, &force_}) std::fill_n(field->begin() + from, count, Vec<Dim>::Zero());
+  }
+}
+
+template <int Dim>
+void Solver<Dim>::clear_dropped() {
+  for (const NodeRun& r : active_.dropped()) {
+    const auto from = static_cast<std::ptrdiff_t>(r.first);
+    for (auto* field : {&velocity_, &velocity_new_}) std::fill_n(field->begin() + from, r.count, Vec<Dim>::Zero());
   }
 }
 
@@ -667,7 +678,7 @@ template <class Shape>
 void Solver<Dim>::update_and_scatter(double dt) {
   auto& p = particles_;
   const ForceTerms<Dim> terms = force_terms(p, settings_);
-  // force_ is zero: clear_grid zeroed it, and the pointwise update runs
+  // force_ is zero: clear_sums zeroed it, and the pointwise update runs
   // without smooth_dilatation, the one pass that borrows it before the forces.
   Scatter<Vec<Dim>> forces{thread_vector_, force_, active_.runs()};
   double plastic = 0, damage = 0;
@@ -764,16 +775,15 @@ void Solver<Dim>::over_layer(int axis, int row, F&& f) const {
   ij[axis] = row;
   const int a = axis == 0 ? 1 : 0, b = axis == 2 ? 1 : 2;  // the other axes (b: 3D only)
   const int layers = Dim == 2 ? 1 : grid_.nodes_along(b), along = grid_.nodes_along(a);
+  const std::ptrdiff_t step = grid_.stride(a);
   constexpr int size = ActiveBlocks<Dim>::size;
   for (int l = 0; l < layers; ++l) {
     if constexpr (Dim == 3) ij[b] = l;
     for (int from = 0; from < along; from += size) {
       ij[a] = from;
       if (!active_.holds(ij)) continue;
-      for (int k = from; k < std::min(from + size, along); ++k) {
-        ij[a] = k;
-        f(ij);
-      }
+      auto i = static_cast<std::ptrdiff_t>(grid_.index(ij));
+      for (int k = from; k < std::min(from + size, along); ++k, i += step) f(static_cast<std::size_t>(i));
     }
   }
 }
@@ -788,11 +798,11 @@ void Solver<Dim>::fold_ghosts(std::vector<double>* mass, std::vector<Vec<Dim>>& 
     const int outward = side % 2 == 0 ? -1 : 1;
     const int wall_row = outward < 0 ? g : g + grid_.cells[axis];
     const double tangential = wall.type == Wall::Type::fixed ? -1.0 : 1.0;
-    for (int depth = 1; depth <= g; ++depth)
-      over_layer(axis, wall_row + depth * outward, [&](const std::array<int, Dim>& ghost) {
-        std::array<int, Dim> mirror = ghost;
-        mirror[axis] = wall_row - depth * outward;
-        const std::size_t from = grid_.index(ghost), to = grid_.index(mirror);
+    for (int depth = 1; depth <= g; ++depth) {
+      // From the ghost `depth` rows out to its mirror as far in.
+      const std::ptrdiff_t inward = -2 * depth * outward * grid_.stride(axis);
+      over_layer(axis, wall_row + depth * outward, [&](std::size_t from) {
+        const std::size_t to = from + inward;
         if (mass) (*mass)[to] += (*mass)[from];
         for (int d = 0; d < Dim; ++d)
           if (d == axis)
@@ -800,6 +810,7 @@ void Solver<Dim>::fold_ghosts(std::vector<double>* mass, std::vector<Vec<Dim>>& 
           else
             vectors[to][d] += tangential * vectors[from][d];
       });
+    }
   }
 }
 
@@ -835,13 +846,11 @@ double Solver<Dim>::apply_walls(std::vector<Vec<Dim>>& velocity) const {
       const int wall_row = outward < 0 ? g : g + grid_.cells[axis];
       Vec<Dim> normal = Vec<Dim>::Zero();
       normal[axis] = outward;
-      over_layer(axis, wall_row + depth * outward, [&](const std::array<int, Dim>& ij) {
-        const std::size_t i = grid_.index(ij);
+      const std::ptrdiff_t inward = -2 * depth * outward * grid_.stride(axis);  // to the mirror
+      over_layer(axis, wall_row + depth * outward, [&](std::size_t i) {
         Vec<Dim>& v = velocity[i];
         if (depth > 0 && wall.type != Wall::Type::friction) {
-          std::array<int, Dim> mirror = ij;
-          mirror[axis] = wall_row - depth * outward;
-          const Vec<Dim>& m = velocity[grid_.index(mirror)];
+          const Vec<Dim>& m = velocity[i + inward];
           for (int d = 0; d < Dim; ++d) v[d] = d == axis || wall.type == Wall::Type::fixed ? -m[d] : m[d];
           return;
         }

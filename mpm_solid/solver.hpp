@@ -383,7 +383,10 @@ class Solver {
   std::vector<std::vector<Vec<Dim>>> thread_vector_;
   std::vector<std::array<int, Dim>> node_ij_;  // grid coordinates of each node
   ActiveBlocks<Dim> active_;  // where the nodal arrays may be nonzero
-  void clear_grid();     // zeroes them there, before a new mapping
+  // Zero the sums (mass, momentum, force) there before a new mapping; run by
+  // every thread of a parallel region.
+  void clear_sums();
+  void clear_dropped();  // zero the velocities where the mapping no longer reaches
   // Nodes whose mass counts once (in the damping's work): not the ghosts
   // beyond a fixed or roller wall, whose share fold_ghosts moved inside.
   std::vector<char> counted_;

@@ -98,3 +98,28 @@ TEST_CASE("between steps every nodal value outside the active blocks is zero, on
   }
   CHECK(solver.active_nodes() < g.num_nodes());
 }
+
+TEST_CASE("a body crossing blocks leaves no velocity behind in the blocks it left, on two threads",
+          "[mpm][active grid]") {
+  const Scheme scheme = GENERATE(Scheme::usf, Scheme::usl, Scheme::musl);
+  const ShapeKind shape = GENERATE(ShapeKind::linear, ShapeKind::bspline);
+  const ThreadsFor two(2);
+  // A block 0.5 m wide flying right through open space, 1.6 m in 200 steps
+  // (two blocks of 8 nodes at h = 0.1 m): the grid's velocities, written only
+  // where the mapping reaches, must be cleared where it no longer does.
+  const Grid<2> g = grid(4.0, 1.0, 0.1);
+  Particles<2> p = block(g, Vec<2>(0.2, 0.2), Vec<2>(0.7, 0.7), 1000, 2);
+  for (auto& v : p.v) v = Vec<2>(40.0, 0.0);
+  Settings<2> s;
+  s.scheme = scheme;
+  s.shape = shape;
+  Solver<2> solver(g, elastic({1000, 1e7, 0.3}), std::move(p), s);
+  const double start = solver.particles().x[0].x();
+  const double dt = 2e-4;
+  for (int k = 0; k < 200; ++k) {
+    solver.step(dt);
+    INFO("step " << k + 1);
+    REQUIRE(solver.stray_nodal_values() == 0);
+  }
+  CHECK(solver.particles().x[0].x() - start > 1.5);
+}
