@@ -243,12 +243,15 @@ TEST_CASE("elastic-damage: a chunk settled over SIMD lanes ends as each of its p
   // particles that need settle's scalar path (the last steps with every
   // other particle, members the lanes reach through their list); updated
   // one at a time, the same code runs on a single lane. The two must agree
-  // to the bit, but for the acting stress, which the compiler's fused
-  // multiply-adds (placed apart in vector and scalar code) may move by an
-  // ulp. And over the last step, whichever path took a particle, its damage
-  // must be the law's (the public, scalar form) and, where it did not slide,
-  // its acting stress its effective one with the tensile principal parts
-  // scaled by 1 - D (an eigendecomposition of its own).
+  // to the bit, but for the acting stress and, once friction has returned
+  // it, the effective stress and the plastic strain: the compiler's fused
+  // multiply-adds (placed apart in vector and scalar code) may move them by
+  // an ulp, which the return's sum of a mean and a deviator of nearly
+  // opposite size makes 1e-15 of the stress a few times over. And over the
+  // last step, whichever path took a particle, its damage must be the law's
+  // (the public, scalar form) and, where it did not slide, its acting stress
+  // its effective one with the tensile principal parts scaled by 1 - D (an
+  // eigendecomposition of its own).
   const auto run = [](const DamageParameters& d) {
     ElasticDamage<2> m("coal", coal, d);
     const int n = chunk_size;
@@ -306,11 +309,14 @@ TEST_CASE("elastic-damage: a chunk settled over SIMD lanes ends as each of its p
         CHECK((together.stress[k] - acting).norm() <= 1e-12 * effective.norm());
         CHECK(together.stress_zz[k] == (effective_zz > 0 ? kept * effective_zz : effective_zz));
       }
-      CHECK((together.stress[k] - alone.stress[k]).norm() <= 1e-15 * alone.stress[k].norm());
-      CHECK(together.stress_zz[k] == alone.stress_zz[k]);
-      CHECK(together.effective_stress[k] == alone.effective_stress[k]);
+      const bool slid = alone.plastic_strain[k] > 0;  // at any step: the ulps stay
+      const double ulps = slid ? 1e-13 : 1e-15;
+      CHECK((together.stress[k] - alone.stress[k]).norm() <= ulps * alone.stress[k].norm());
+      CHECK(std::abs(together.stress_zz[k] - alone.stress_zz[k]) <= (slid ? ulps * alone.stress[k].norm() : 0.0));
+      CHECK((together.effective_stress[k] - alone.effective_stress[k]).norm() <=
+            (slid ? ulps * alone.effective_stress[k].norm() : 0.0));
       CHECK(together.damage[k] == alone.damage[k]);
-      CHECK(together.plastic_strain[k] == alone.plastic_strain[k]);
+      CHECK(together.plastic_strain[k] == Approx(alone.plastic_strain[k]).epsilon(slid ? 1e-12 : 0.0));
       CHECK(together.volume[k] == alone.volume[k]);
       // Settle's friction, whichever path took the particle: a compressive
       // state within the cone of the cohesion its damage leaves.

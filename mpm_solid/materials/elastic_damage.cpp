@@ -58,14 +58,15 @@ struct Principal<2> {
   double sum() const { return a + b; }
   // The entries in Eigen's column-major order, each as Eigen formed
   // (crack(a) direction) direction^T + (crack(b) normal) normal^T.
-  void cracked(double factor, double* out) const {
+  void cracked(double factor, double& xx, double& yx, double& xy, double& yy) const {
     const double ca = crack(a, factor), cb = crack(b, factor), nx = -sin, ny = cos;
     const double t0 = ca * cos, t1 = ca * sin, u0 = cb * nx, u1 = cb * ny;
-    out[0] = t0 * cos + u0 * nx;
-    out[1] = t1 * cos + u1 * nx;
-    out[2] = t0 * sin + u0 * ny;
-    out[3] = t1 * sin + u1 * ny;
+    xx = t0 * cos + u0 * nx;
+    yx = t1 * cos + u1 * nx;
+    xy = t0 * sin + u0 * ny;
+    yy = t1 * sin + u1 * ny;
   }
+  void cracked(double factor, double* out) const { cracked(factor, out[0], out[1], out[2], out[3]); }
   Mat<2> cracked(double factor) const {
     Mat<2> m;
     cracked(factor, m.data());
@@ -408,14 +409,17 @@ Dissipation ElasticDamage<Dim>::update_alone(Particles<Dim>& p, int i) const {
   return settle(p, i, damage(p.damage[i], st, strength_scale(p, i), stiffness), st);
 }
 
-// Most of the coal, most of the time, neither cracks further nor slides: its
-// acting stress (and a broken particle's bulking) is all that settle would
-// change. That is found and set for a chunk at once, each particle's
-// arithmetic settle's, so that the lanes move no result where the compiler
-// fuses no products of its own (-DOUTBURST_NO_FP_CONTRACTION=ON; with its
-// fused multiply-adds, placed apart in vector and scalar code, an ulp);
-// settle itself runs after for the rest, in the members' order, which keeps
-// the sums of what they dissipated.
+// Most of the coal, most of the time, does not crack further: settling then
+// sets its acting stress, returns a compressive one that lies beyond the
+// friction cone to it (the sliding of broken coal) and caps a broken
+// particle's bulking. That is done for a chunk at once over SIMD lanes, each
+// particle's arithmetic settle's and drucker_prager_return's written out in
+// their order (Eigen's, for the deviator's squared norm), so that the lanes
+// move no result where the compiler fuses no products of its own
+// (-DOUTBURST_NO_FP_CONTRACTION=ON; with its fused multiply-adds, placed
+// apart in vector and scalar code, an ulp). settle itself runs after for the
+// particles whose damage grew, and the dissipation is summed in the members'
+// order.
 template <int Dim>
 template <bool Drawn, bool Band, class Index>
 Dissipation ElasticDamage<Dim>::settle_plane(Particles<Dim>& p, std::span<const int> members, Index index) const {
@@ -423,8 +427,8 @@ Dissipation ElasticDamage<Dim>::settle_plane(Particles<Dim>& p, std::span<const 
   const int n = static_cast<int>(members.size());
   assert(n <= chunk_size);
   // Every field by a local pointer, as deform_and_trial's.
-  const double* const effective = p.effective_stress.data()->data();
-  const double* const effective_zz = p.effective_stress_zz.data();
+  double* const effective = p.effective_stress.data()->data();
+  double* const effective_zz = p.effective_stress_zz.data();
   const double* const damaged = p.damage.data();
   const double* const strength = Drawn ? p.strength_scale.data() : nullptr;
   const double* const modulus = Drawn ? p.modulus_scale.data() : nullptr;
@@ -432,42 +436,80 @@ Dissipation ElasticDamage<Dim>::settle_plane(Particles<Dim>& p, std::span<const 
   double* const acting_zz = p.stress_zz.data();
   double* const volume = p.volume.data();
   const double* const volume0 = p.volume0.data();
-  const double bulking = parameters_.bulking_factor;
-  // Doubles, chosen by nested selects: GCC 12 vectorises no mask combined
-  // by && or stored as bool here.
-  double quick[chunk_size];
+  double* const plastic_strain = p.plastic_strain.data();
+  const double bulking = parameters_.bulking_factor, shear = this->shear_modulus(), lame = this->lame_lambda();
+  const double alpha = alpha_, k0 = k0_;
+  // Per member: 0 where damage grew (settle's), 1 where the stress held, 2
+  // where it slid, with the plastic work that took. Doubles, chosen by
+  // nested selects: GCC 12 vectorises no mask combined by && or stored as
+  // bool here.
+  double verdict[chunk_size], plastic[chunk_size];
 #pragma omp simd
   for (int k = 0; k < n; ++k) {
     const std::ptrdiff_t i = index(k);
-    const double* e = effective + 4 * i;
+    double* const e = effective + 4 * i;
+    const double x0 = e[0], x1 = e[1], x2 = e[2], x3 = e[3];
     const double zz = effective_zz[i], previous = damaged[i];
     const double scale = Drawn ? strength[i] : 1.0, stiffness = Drawn ? modulus[i] : 1.0;
-    const Principal<2> pr(e[0], e[3], e[2]);
+    const Principal<2> pr(x0, x3, x2);
     const Stresses st = plane_stresses(pr, zz, stiffness);
     const double d = damage<Band>(previous, st, scale, stiffness);
-    double* s = acting + 4 * i;
-    pr.cracked(1 - d, s);
+    double s0, s1, s2, s3;  // Eigen's column-major order
+    pr.cracked(1 - d, s0, s1, s2, s3);
     const double s_zz = crack(zz, 1 - d);
-    acting_zz[i] = s_zz;
-    // settle's friction test (its sum, then its cone), the cone's value
-    // summed in another order: the lanes take only what lies inside it by
-    // more than that order's rounding (1e-16 of its terms) could move.
-    const double sum = s[0] + s[3] + s_zz, mean = sum / 3;
-    const double xx = s[0] - mean, yy = s[3] - mean, z = s_zz - mean;
-    const double sqrt_j2 = std::sqrt(0.5 * (xx * xx + s[1] * s[1] + s[2] * s[2] + yy * yy + z * z));
-    const double cone = alpha_ * mean + sqrt_j2, k0 = (1 - d) * scale * k0_;
-    const double holds =
-        sum >= 0 ? 1.0 : cone - k0 < -1e-12 * (std::abs(alpha_ * mean) + sqrt_j2 + k0) ? 1.0 : 0.0;
-    // No growth of damage. Broken coal, most of the coal once it has burst,
-    // bulks no further than settle lets it; settle's own cap, after its
-    // books, for the particles it takes.
-    quick[k] = d == previous ? holds : 0.0;
+    // settle's friction: drucker_prager_return with no dilation, as written
+    // there (Eigen's deviator s - mean I and stress mean I + ratio deviator
+    // entry by entry, and the squared norm's pairs as its packets sum them).
+    const double g = stiffness * shear, bulk = stiffness * lame + 2.0 / 3.0 * g;
+    const double cohesion = (1 - d) * scale * k0;
+    const double sum = s0 + s3 + s_zz, mean = sum / 3;
+    const double d00 = s0 - mean * 1.0, d10 = s1 - mean * 0.0, d01 = s2 - mean * 0.0, d11 = s3 - mean * 1.0;
+    const double d_zz = s_zz - mean;
+    const double squared = (d00 * d00 + d01 * d01) + (d10 * d10 + d11 * d11);
+    const double sqrt_j2 = std::sqrt(0.5 * (squared + d_zz * d_zz));
+    const double f = alpha * mean + sqrt_j2 - cohesion;
+    const double along = f / (g + bulk * alpha * 0.0);
+    const double shrunk = sqrt_j2 - g * along;
+    // Past the apex (where no cohesion is left to hold tension), the apex.
+    const double to_mean = shrunk < 0 ? cohesion / alpha : mean - bulk * 0.0 * along;
+    const double to_sqrt_j2 = shrunk < 0 ? 0.0 : shrunk;
+    const double multiplier = shrunk < 0 ? sqrt_j2 / g : along;
+    const double quotient = to_sqrt_j2 / sqrt_j2, ratio = sqrt_j2 > 0 ? quotient : 0.0;
+    const double r00 = to_mean * 1.0 + ratio * d00, r10 = to_mean * 0.0 + ratio * d10,
+                 r01 = to_mean * 0.0 + ratio * d01, r11 = to_mean * 1.0 + ratio * d11;
+    const double r_zz = to_mean + ratio * d_zz;
+    const double work = to_sqrt_j2 * (sqrt_j2 - to_sqrt_j2) / g + to_mean * (mean - to_mean) / bulk;
+    // The undamaged stress the return carries back to (same principal axes).
+    const Principal<2> back(r00, r11, r01);
+    const double inverse = 1 / (1 - d), open = d < 1 ? inverse : 0.0;
+    double e0, e1, e2, e3;
+    back.cracked(open, e0, e1, e2, e3);
+    const double slides = d == previous ? (sum < 0 ? (f > 0 ? 1.0 : 0.0) : 0.0) : 0.0;
+    verdict[k] = d == previous ? 1.0 + slides : 0.0;
+    plastic[k] = slides != 0 ? volume[i] * work : 0.0;
+    plastic_strain[i] = slides != 0 ? plastic_strain[i] + multiplier / std::sqrt(3.0) : plastic_strain[i];
+    double* const a = acting + 4 * i;
+    a[0] = slides != 0 ? r00 : s0;
+    a[1] = slides != 0 ? r10 : s1;
+    a[2] = slides != 0 ? r01 : s2;
+    a[3] = slides != 0 ? r11 : s3;
+    acting_zz[i] = slides != 0 ? r_zz : s_zz;
+    e[0] = slides != 0 ? e0 : x0;
+    e[1] = slides != 0 ? e1 : x1;
+    e[2] = slides != 0 ? e2 : x2;
+    e[3] = slides != 0 ? e3 : x3;
     const double bulked = d >= 1 ? std::min(volume[i], bulking * volume0[i]) : volume[i];
-    volume[i] = quick[k] != 0 ? bulked : volume[i];
+    volume[i] = d == previous ? bulked : volume[i];
+    const double back_zz = crack(r_zz, open);
+    effective_zz[i] = slides != 0 ? back_zz : zz;
   }
   Dissipation total;
-  for (int k = 0; k < n; ++k)
-    if (quick[k] == 0) total += update_alone(p, static_cast<int>(index(k)));
+  for (int k = 0; k < n; ++k) {
+    if (verdict[k] == 0)
+      total += update_alone(p, static_cast<int>(index(k)));
+    else if (verdict[k] == 2)
+      total += Dissipation{plastic[k], 0.0};
+  }
   return total;
 }
 

@@ -147,8 +147,8 @@ class ElasticDamage final : public Material<Dim> {
   // its decomposition, the damage law and settle.
   Dissipation update_alone(Particles<Dim>& p, int i) const;
   // The plane's pointwise update of a chunk of members after the trial,
-  // member k particle index(k): over SIMD lanes where settling only sets the
-  // acting stress (no damage growth, no friction; bulking capped), by settle
+  // member k particle index(k): over SIMD lanes where damage does not grow
+  // (the acting stress, friction's return, the bulking cap), by settle
   // elsewhere.
   template <bool Drawn, bool Band, class Index>
   Dissipation settle_plane(Particles<Dim>& p, std::span<const int> members, Index index) const;
