@@ -499,12 +499,6 @@ void Solver<Dim>::scatter_mass_momentum() {
   if (outside > 0)
     throw SimulationError(fmt::format("mpm: step {}: {} particles lie beyond the grid's ghost nodes", steps_ + 1,
                                       outside));
-  if (!masses.others.empty())
-    over_nodes(active_.runs(), [&](std::size_t i) {
-      masses.gather(i);
-      momenta.gather(i);
-    });
-  fold_ghosts(&mass_, momentum_);
 }
 
 template <int Dim>
@@ -546,11 +540,22 @@ void Solver<Dim>::clear_dropped() {
   }
 }
 
+// The threads' copies of the mass and momentum summed, and the velocities
+// taken, in one pass; the ghost folds then change the nodes they fold into,
+// whose velocities are taken again.
 template <int Dim>
 void Solver<Dim>::grid_velocities() {
-  over_nodes(active_.runs(), [&](std::size_t i) {
+  Scatter<double> masses{thread_mass_, mass_, active_.runs()};
+  Scatter<Vec<Dim>> momenta{thread_vector_, momentum_, active_.runs()};
+  const auto velocity = [&](std::size_t i) {
     velocity_[i] = mass_[i] > empty_node_mass_ ? Vec<Dim>(momentum_[i] / mass_[i]) : Vec<Dim>::Zero();
+  };
+  over_nodes(active_.runs(), [&](std::size_t i) {
+    masses.gather(i);
+    momenta.gather(i);
+    velocity(i);
   });
+  fold_ghosts(&mass_, momentum_, velocity);
   apply_platens(velocity_, 0, 0);
   apply_walls(velocity_);
 }
@@ -660,8 +665,6 @@ void Solver<Dim>::scatter_forces() {
       for (int lane = 0; lane < lanes; ++lane) add_forces(p, terms, start + lane, s, lane, f);
     });
   }
-  forces.gather();
-  fold_ghosts(nullptr, force_);
 }
 
 // gather_velocity_gradient, update_stresses and scatter_forces in one pass, a
@@ -708,14 +711,24 @@ void Solver<Dim>::update_and_scatter(double dt) {
   }
   dissipated_.plastic += plastic;
   dissipated_.damage += damage;
-  forces.gather();
-  fold_ghosts(nullptr, force_);
 }
 
+// The threads' copies of the force are summed first. Without local damping
+// (which reads the summed forces) that pass takes the updated velocities too,
+// and the nodes the ghost folds change take theirs again.
 template <int Dim>
 void Solver<Dim>::grid_update(double dt) {
   const Runs& runs = active_.runs();
+  Scatter<Vec<Dim>> forces{thread_vector_, force_, runs};
+  // v_new = (v + dt f / m) / (1 + c dt): the viscous force -c m v_new.
+  const double c = settings_.viscous_damping, shrink = 1 / (1 + c * dt);
+  const auto update = [&](std::size_t i) {
+    velocity_new_[i] =
+        mass_[i] > empty_node_mass_ ? Vec<Dim>(shrink * (velocity_[i] + dt * force_[i] / mass_[i])) : Vec<Dim>::Zero();
+  };
   if (const double alpha = settings_.local_damping; alpha > 0) {
+    forces.gather();
+    fold_ghosts(nullptr, force_, [](std::size_t) {});
     dissipated_.damping += sum_over_nodes(runs, [&](std::size_t i) {
       double work = 0;
       for (int d = 0; d < Dim; ++d)
@@ -728,13 +741,14 @@ void Solver<Dim>::grid_update(double dt) {
         }
       return work;
     });
+    over_nodes(runs, update);
+  } else {
+    over_nodes(runs, [&](std::size_t i) {
+      forces.gather(i);
+      update(i);
+    });
+    fold_ghosts(nullptr, force_, update);
   }
-  // v_new = (v + dt f / m) / (1 + c dt): the viscous force -c m v_new.
-  const double c = settings_.viscous_damping, shrink = 1 / (1 + c * dt);
-  over_nodes(runs, [&](std::size_t i) {
-    velocity_new_[i] =
-        mass_[i] > empty_node_mass_ ? Vec<Dim>(shrink * (velocity_[i] + dt * force_[i] / mass_[i])) : Vec<Dim>::Zero();
-  });
   apply_platens(velocity_new_, shrink * dt, dt);  // before the walls: the ghost nodes mirror the plate's motion
   dissipated_.walls += apply_walls(velocity_new_);
   // The grid's work on pure FLIP particles is sum_i p_i . dv_i here, with
@@ -789,7 +803,8 @@ void Solver<Dim>::over_layer(int axis, int row, F&& f) const {
 }
 
 template <int Dim>
-void Solver<Dim>::fold_ghosts(std::vector<double>* mass, std::vector<Vec<Dim>>& vectors) const {
+template <class F>
+void Solver<Dim>::fold_ghosts(std::vector<double>* mass, std::vector<Vec<Dim>>& vectors, F&& refresh) const {
   const int g = Grid<Dim>::ghost;
   for (int side = 0; side < 2 * Dim; ++side) {
     const Wall& wall = settings_.walls[side];
@@ -809,6 +824,7 @@ void Solver<Dim>::fold_ghosts(std::vector<double>* mass, std::vector<Vec<Dim>>& 
             vectors[to][d] -= vectors[from][d];
           else
             vectors[to][d] += tangential * vectors[from][d];
+        refresh(to);
       });
     }
   }

@@ -342,7 +342,11 @@ class Solver {
   void apply_platens(std::vector<Vec<Dim>>& velocity, double impulse, double dt);
   void find_obstacle_nodes();
   void remove_supports();  // the settling stage is over
-  void fold_ghosts(std::vector<double>* mass, std::vector<Vec<Dim>>& vectors) const;
+  // Folds what the particles gave the ghost nodes beyond fixed and roller
+  // walls into their mirrors inside (mass, if given, and vectors), and calls
+  // refresh(node) at each node folded into, after its fold.
+  template <class F>
+  void fold_ghosts(std::vector<double>* mass, std::vector<Vec<Dim>>& vectors, F&& refresh) const;
   // f(node) over the nodes of the layer `row` across `axis` (a row of nodes
   // in 2D, a plane in 3D), ghosts included, in active blocks: elsewhere every
   // nodal value is zero, which walls and folds leave so.
