@@ -476,6 +476,8 @@ block("outburst cost settle lanes", "cases/outburst/benchmark/outburst-benchmark
 block("mpm benchmark active walls", "mpm_solid/benchmark/compare-63e0ffd-877286d-98ecb4e.csv")(mpm_benchmark_builds)
 block("outburst cost active walls", "cases/outburst/benchmark/outburst-benchmark-active-walls.csv")(outburst_cost)
 block("outburst cost gas lanes", "cases/outburst/benchmark/outburst-benchmark-gas-lanes.csv")(outburst_cost)
+block("mpm benchmark sliding lanes", "mpm_solid/benchmark/compare-63e0ffd-906bedb-145f429.csv")(mpm_benchmark_builds)
+block("outburst cost serial sliding", "cases/outburst/benchmark/outburst-benchmark-serial-sliding.csv")(outburst_cost)
 
 
 @block("mpm benchmark", "mpm_solid/benchmark/mpm-benchmark.csv")
