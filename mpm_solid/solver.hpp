@@ -190,9 +190,9 @@ struct StepInfo {
 // Wall time the steps have spent in each of their parts, in seconds: where a
 // run's time goes, and which part a second thread speeds up.
 struct StepTimes {
-  double map = 0;     // particles to grid: mass and momentum
-  double grid = 0;    // the grid's velocities and update, walls, platens
-  double stress = 0;  // velocity gradients, the stress update, nodal forces
+  double map = 0;     // particles to grid: mass and momentum scattered
+  double grid = 0;    // the threads' copies summed, ghosts folded, velocities and update, walls, platens
+  double stress = 0;  // velocity gradients, the stress update, nodal forces scattered
   double motion = 0;  // grid to particles: velocities, positions, the census
   double total() const { return map + grid + stress + motion; }
 };

@@ -234,6 +234,52 @@ TEST_CASE("elastic-damage: broken coal bulks to its bulking factor and no furthe
   CHECK(p.volume[0] == Approx(coal_damage.bulking_factor * p.volume0[0]).epsilon(1e-12));
 }
 
+namespace {
+
+// Over one update of particles whose trial is `trial`: each particle of
+// `after` whose damage did not grow and that slid must have the stress and
+// the plastic strain of drucker_prager_return (with no dilation) applied to
+// its trial's acting stress (the tensile principal parts scaled by 1 - D,
+// from an eigendecomposition of its own), and where no damage grew, the
+// update's plastic work (`plastic`) must be the sum of the returns' works.
+// Returns how many slid.
+int check_slides(const ElasticDamage<2>& m, const DamageParameters& d, const Particles<2>& trial,
+                 const Particles<2>& after, const std::vector<double>& damage_before,
+                 const std::vector<double>& slid_before, double plastic) {
+  int slid = 0;
+  bool grew = false;
+  double work_sum = 0, scale_sum = 0;
+  for (std::size_t k = 0; k < after.size(); ++k) {
+    grew = grew || after.damage[k] != damage_before[k];
+    if (after.damage[k] != damage_before[k] || after.plastic_strain[k] == slid_before[k]) continue;
+    CAPTURE(k);
+    ++slid;
+    const double stiffness = d.heterogeneity ? trial.modulus_scale[k] : 1.0;
+    const double strength = d.heterogeneity ? trial.strength_scale[k] : 1.0, kept = 1 - after.damage[k];
+    const Eigen::SelfAdjointEigenSolver<Mat<2>> axes(trial.effective_stress[k]);
+    const Vec<2> values = axes.eigenvalues().unaryExpr([&](double v) { return v > 0 ? kept * v : v; });
+    Mat<2> s = axes.eigenvectors() * values.asDiagonal() * axes.eigenvectors().transpose();
+    const double zz = trial.effective_stress_zz[k];
+    double s_zz = zz > 0 ? kept * zz : zz;
+    const auto [alpha, cohesion] =
+        DruckerPragerFit::coefficients(DruckerPragerFit::Kind::outer, kept * strength * d.cohesion, d.friction_angle);
+    const double g = stiffness * m.shear_modulus(), bulk = stiffness * m.lame_lambda() + 2.0 / 3.0 * g;
+    double work = 0;
+    const double multiplier = drucker_prager_return<2>(alpha, cohesion, 0.0, g, bulk, s, s_zz, &work);
+    const double size = s.norm() + std::abs(s_zz);
+    CHECK(multiplier > 0);
+    CHECK((after.stress[k] - s).norm() <= 1e-9 * size);
+    CHECK(std::abs(after.stress_zz[k] - s_zz) <= 1e-9 * size);
+    CHECK(std::abs(after.plastic_strain[k] - slid_before[k] - multiplier / std::sqrt(3.0)) <= 1e-9 * size / g);
+    work_sum += trial.volume[k] * work;
+    scale_sum += trial.volume[k] * size * size / g;
+  }
+  if (!grew) CHECK(std::abs(plastic - work_sum) <= 1e-9 * scale_sum);
+  return slid;
+}
+
+}  // namespace
+
 TEST_CASE("elastic-damage: a chunk settled over SIMD lanes ends as each of its particles settled alone",
           "[mpm][material][damage]") {
   // 64 particles (a whole chunk) strained along their own paths through
@@ -251,7 +297,9 @@ TEST_CASE("elastic-damage: a chunk settled over SIMD lanes ends as each of its p
   // last step, whichever path took a particle, its damage must be the law's
   // (the public, scalar form) and, where it did not slide, its acting stress
   // its effective one with the tensile principal parts scaled by 1 - D (an
-  // eigendecomposition of its own).
+  // eigendecomposition of its own). At every step, each particle that slid
+  // without cracking further must have what the public return gives its
+  // trial (check_slides).
   const auto run = [](const DamageParameters& d) {
     ElasticDamage<2> m("coal", coal, d);
     const int n = chunk_size;
@@ -275,6 +323,7 @@ TEST_CASE("elastic-damage: a chunk settled over SIMD lanes ends as each of its p
     l[2] = -Mat<2>::Identity();    // squeezed equally
     Particles<2> alone = together;
     Dissipation in_chunk, one_by_one;
+    int slid_alone = 0;
     std::vector<int> evens, odds;
     for (int k = 0; k < n; ++k) (k % 2 ? odds : evens).push_back(k);
     std::vector<double> damage_before, slid_before;
@@ -284,6 +333,13 @@ TEST_CASE("elastic-damage: a chunk settled over SIMD lanes ends as each of its p
       for (int s = 0; s < 100; ++s) {
         damage_before = together.damage;
         slid_before = together.plastic_strain;
+        // The reference for the particles that slide without cracking
+        // further: the public return applied to the trial's acting stress.
+        Particles<2> trial = together;
+        deform_and_trial(trial, std::span<const int>(members), 2e-6, m.lame_lambda(), m.shear_modulus(),
+                         d.heterogeneity ? &trial.modulus_scale : nullptr, trial.effective_stress,
+                         trial.effective_stress_zz);
+        const double plastic_before = in_chunk.plastic;
         if (sign > 0) {
           in_chunk += m.update_stress(together, members, 2e-6);
         } else {
@@ -291,8 +347,11 @@ TEST_CASE("elastic-damage: a chunk settled over SIMD lanes ends as each of its p
           in_chunk += m.update_stress(together, odds, 2e-6);
         }
         for (int k = 0; k < n; ++k) one_by_one += m.update_stress(alone, {k}, 2e-6);
+        slid_alone += check_slides(m, d, trial, together, damage_before, slid_before,
+                                   in_chunk.plastic - plastic_before);
       }
     }
+    CHECK(slid_alone > 0);
     int damaged = 0, broken = 0, sliding = 0;
     for (int k = 0; k < n; ++k) {
       CAPTURE(k);

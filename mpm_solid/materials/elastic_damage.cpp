@@ -470,7 +470,8 @@ Dissipation ElasticDamage<Dim>::settle_plane(Particles<Dim>& p, std::span<const 
     const double f = alpha * mean + sqrt_j2 - cohesion;
     const double along = f / (g + bulk * alpha * 0.0);
     const double shrunk = sqrt_j2 - g * along;
-    // Past the apex (where no cohesion is left to hold tension), the apex.
+    // A return that overshoots the cone's tip ends at the tip, as
+    // drucker_prager_return's does.
     const double to_mean = shrunk < 0 ? cohesion / alpha : mean - bulk * 0.0 * along;
     const double to_sqrt_j2 = shrunk < 0 ? 0.0 : shrunk;
     const double multiplier = shrunk < 0 ? sqrt_j2 / g : along;
