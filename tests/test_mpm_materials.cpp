@@ -236,11 +236,18 @@ TEST_CASE("elastic-damage: broken coal bulks to its bulking factor and no furthe
 
 namespace {
 
+// The stress acting at damage 1 - kept: the tensile principal parts of
+// `effective` scaled by kept, from an eigendecomposition of the test's own.
+Mat<2> cracked(const Mat<2>& effective, double kept) {
+  const Eigen::SelfAdjointEigenSolver<Mat<2>> axes(effective);
+  const Vec<2> values = axes.eigenvalues().unaryExpr([&](double v) { return v > 0 ? kept * v : v; });
+  return axes.eigenvectors() * values.asDiagonal() * axes.eigenvectors().transpose();
+}
+
 // Over one update of particles whose trial is `trial`: each particle of
 // `after` whose damage did not grow and that slid must have the stress and
 // the plastic strain of drucker_prager_return (with no dilation) applied to
-// its trial's acting stress (the tensile principal parts scaled by 1 - D,
-// from an eigendecomposition of its own), and where no damage grew, the
+// its trial's acting stress (cracked), and where no damage grew, the
 // update's plastic work (`plastic`) must be the sum of the returns' works.
 // Returns how many slid.
 int check_slides(const ElasticDamage<2>& m, const DamageParameters& d, const Particles<2>& trial,
@@ -256,9 +263,7 @@ int check_slides(const ElasticDamage<2>& m, const DamageParameters& d, const Par
     ++slid;
     const double stiffness = d.heterogeneity ? trial.modulus_scale[k] : 1.0;
     const double strength = d.heterogeneity ? trial.strength_scale[k] : 1.0, kept = 1 - after.damage[k];
-    const Eigen::SelfAdjointEigenSolver<Mat<2>> axes(trial.effective_stress[k]);
-    const Vec<2> values = axes.eigenvalues().unaryExpr([&](double v) { return v > 0 ? kept * v : v; });
-    Mat<2> s = axes.eigenvectors() * values.asDiagonal() * axes.eigenvectors().transpose();
+    Mat<2> s = cracked(trial.effective_stress[k], kept);
     const double zz = trial.effective_stress_zz[k];
     double s_zz = zz > 0 ? kept * zz : zz;
     const auto [alpha, cohesion] =
@@ -362,9 +367,7 @@ TEST_CASE("elastic-damage: a chunk settled over SIMD lanes ends as each of its p
       if (together.plastic_strain[k] == slid_before[k]) {
         CHECK(together.damage[k] ==
               Approx(m.damage(damage_before[k], effective, effective_zz, strength, stiffness)).margin(1e-14));
-        const Eigen::SelfAdjointEigenSolver<Mat<2>> axes(effective);
-        const Vec<2> values = axes.eigenvalues().unaryExpr([&](double v) { return v > 0 ? kept * v : v; });
-        const Mat<2> acting = axes.eigenvectors() * values.asDiagonal() * axes.eigenvectors().transpose();
+        const Mat<2> acting = cracked(effective, kept);
         CHECK((together.stress[k] - acting).norm() <= 1e-12 * effective.norm());
         CHECK(together.stress_zz[k] == (effective_zz > 0 ? kept * effective_zz : effective_zz));
       }
