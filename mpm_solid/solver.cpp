@@ -699,13 +699,17 @@ void Solver<Dim>::update_and_scatter(double dt) {
       for (int c = 0; c < chunks; ++c) {
         const auto chunk = members.subspan(c * chunk_size, std::min(chunk_size, n - c * chunk_size));
         const int lanes = static_cast<int>(chunk.size());
-        const auto particle = [&chunk](int lane) { return chunk[static_cast<std::size_t>(lane)]; };
-        s.compute(p.x.data(), p.half_width.data(), particle, lanes);
-        velocity_gradients(velocity_, s, lanes, particle, p.velocity_gradient);
-        const Dissipation d = materials_[m]->update_chunk(p, chunk, dt);
-        plastic += d.plastic;
-        damage += d.damage;
-        for (int lane = 0; lane < lanes; ++lane) add_forces(p, terms, chunk[lane], s, lane, f);
+        // Consecutive members by position: the lanes load the positions and
+        // store the gradients as blocks; through the list they were gathers
+        // and scatters, the positions' gather the pass's hottest instruction.
+        by_position(chunk, [&](auto particle) __attribute__((always_inline)) {
+          s.compute(p.x.data(), p.half_width.data(), particle, lanes);
+          velocity_gradients(velocity_, s, lanes, particle, p.velocity_gradient);
+          const Dissipation d = materials_[m]->update_chunk(p, chunk, dt);
+          plastic += d.plastic;
+          damage += d.damage;
+          for (int lane = 0; lane < lanes; ++lane) add_forces(p, terms, static_cast<int>(particle(lane)), s, lane, f);
+        });
       }
     }
   }
