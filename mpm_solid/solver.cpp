@@ -130,6 +130,34 @@ template <int Dim, class Shape, int Width, class Index>
   }
 }
 
+// Scatters the mass and momentum of particles start .. start + lanes - 1,
+// whose stencils s holds, into m and mv, and marks the blocks they reach;
+// returns how many lie beyond the ghost nodes (not mapped).
+template <int Dim, class Shape, int Width>
+[[gnu::always_inline]] inline long map_lanes(const Particles<Dim>& p, const StencilLanes<Dim, Shape, Width>& s,
+                                             int start, int lanes, double* m, Vec<Dim>* mv, std::uint8_t* reached,
+                                             const std::array<int, Dim - 1>& strides) {
+  long outside = 0;
+  for (int lane = 0; lane < lanes; ++lane) {
+    if (!s.inside(lane)) {
+      ++outside;
+      continue;
+    }
+    ActiveBlocks<Dim>::template set_reached<Shape::support>(reached, strides, s.lowest(lane));
+    const int i = start + lane;
+    const double mass = p.mass[i];
+    const Vec<Dim> v = p.v[i];
+    double* m_at = m + s.first[lane];
+    Vec<Dim>* mv_at = mv + s.first[lane];
+    s.for_each_node([&](int k, const std::array<int, Dim>& a) {
+      const double wm = s.weight(a, lane) * mass;
+      m_at[s.offset[k]] += wm;
+      mv_at[s.offset[k]] += wm * v;
+    });
+  }
+  return outside;
+}
+
 // What a step's nodal forces take from the particles, decided once per pass:
 // a scene without gravity or loads skips the body-force term altogether.
 template <int Dim>
@@ -437,6 +465,10 @@ double Solver<Dim>::stable_time_step() const {
 template <int Dim>
 template <class Shape, bool Apic>
 void Solver<Dim>::scatter_mass_momentum() {
+  if (mapped_ahead_) {  // by the last step's move (gather_motion)
+    mapped_ahead_ = false;
+    return;
+  }
   const auto& p = particles_;
   const int n = static_cast<int>(p.size());
   Scatter<double> masses{thread_mass_, mass_, active_.runs()};
@@ -452,27 +484,9 @@ void Solver<Dim>::scatter_mass_momentum() {
     const Lattice<Dim> lattice(grid_);
     if constexpr (!Apic) {
       StencilLanes<Dim, Shape> s(lattice);
-      over_chunks(s, p, [&](int start, int lanes) {
-        for (int lane = 0; lane < lanes; ++lane) {
-          // Particles leave the grid at the end of a step; one beyond its ghost
-          // nodes here came from outside (a solver built with it there).
-          if (!s.inside(lane)) {
-            ++outside;
-            continue;
-          }
-          ActiveBlocks<Dim>::template set_reached<Shape::support>(reached, strides, s.lowest(lane));
-          const int i = start + lane;
-          const double mass = p.mass[i];
-          const Vec<Dim> v = p.v[i];
-          double* m_at = m + s.first[lane];
-          Vec<Dim>* mv_at = mv + s.first[lane];
-          s.for_each_node([&](int k, const std::array<int, Dim>& a) {
-            const double wm = s.weight(a, lane) * mass;
-            m_at[s.offset[k]] += wm;
-            mv_at[s.offset[k]] += wm * v;
-          });
-        }
-      });
+      // Particles leave the grid at the end of a step; one beyond its ghost
+      // nodes here came from outside (a solver built with it there).
+      over_chunks(s, p, [&](int start, int lanes) { outside += map_lanes(p, s, start, lanes, m, mv, reached, strides); });
     } else {
       Stencil<Dim, Shape> s;
 #pragma omp for schedule(static)
@@ -510,8 +524,12 @@ std::size_t Solver<Dim>::stray_nodal_values() const {
     if (!active[i])
       stray += (mass_[i] != 0) + (momentum_[i] != Vec<Dim>::Zero()) + (force_[i] != Vec<Dim>::Zero()) +
                (velocity_[i] != Vec<Dim>::Zero()) + (velocity_new_[i] != Vec<Dim>::Zero());
-    for (const auto& t : thread_mass_) stray += t[i] != 0;
-    for (const auto& t : thread_vector_) stray += t[i] != Vec<Dim>::Zero();
+    // Mapped ahead, the threads' copies hold the next step's sums until
+    // grid_velocities adds them in: only on the active nodes.
+    if (!mapped_ahead_ || !active[i]) {
+      for (const auto& t : thread_mass_) stray += t[i] != 0;
+      for (const auto& t : thread_vector_) stray += t[i] != Vec<Dim>::Zero();
+    }
   }
   return stray;
 }
@@ -530,6 +548,20 @@ void Solver<Dim>::clear_sums() {
     std::fill_n(mass_.begin() + from, count, 0.0);
     for (auto* field : {&momentum_, &force_}) std::fill_n(field->begin() + from, count, Vec<Dim>::Zero());
   }
+}
+
+template <int Dim>
+void Solver<Dim>::discard_mapping() {
+  if (!mapped_ahead_) return;
+  mapped_ahead_ = false;
+  Scatter<double> masses{thread_mass_, mass_, active_.runs()};
+  Scatter<Vec<Dim>> momenta{thread_vector_, momentum_, active_.runs()};
+  over_nodes(active_.runs(), [&](std::size_t i) {
+    masses.gather(i);
+    momenta.gather(i);
+    mass_[i] = 0;
+    momentum_[i] = Vec<Dim>::Zero();
+  });
 }
 
 template <int Dim>
@@ -1117,10 +1149,27 @@ void Solver<Dim>::gather_motion(double dt) {
   } else {
     using Lanes = StencilLanes<Dim, Shape>;
     const double *now = velocity_.data()->data(), *next = velocity_new_.data()->data();
-#pragma omp parallel reduction(merge : census) reduction(+ : lost, work, gained)
+    // Under Move the particles just moved map their mass and momentum for the
+    // next step as well (README.md, The MPM solver): the chunk's positions
+    // and velocities are still in registers and cache, and a pass over the
+    // particles and a parallel region a step are saved.
+    Scatter<double> masses{thread_mass_, mass_, active_.runs()};
+    Scatter<Vec<Dim>> momenta{thread_vector_, momentum_, active_.runs()};
+    long outside = 0;
+#pragma omp parallel num_threads(threads_) reduction(merge : census) reduction(+ : lost, work, gained, outside)
     {
       const Lattice<Dim> lattice(grid_);
-      Lanes s(lattice);
+      Lanes s(lattice), ahead(lattice);
+      double* m = nullptr;
+      Vec<Dim>* mv = nullptr;
+      std::uint8_t* reached = nullptr;
+      const auto strides = active_.strides();
+      if constexpr (Move) {
+        clear_sums();  // the step's sums were last read by grid_update
+        m = masses.buffer(omp_get_thread_num()).data();
+        mv = momenta.buffer(omp_get_thread_num()).data();
+        reached = active_.marks(omp_get_thread_num());
+      }
       over_chunks(s, p, [&](int start, int lanes) __attribute__((always_inline)) {
         alignas(64) double v_pic[Dim][Lanes::width] = {}, dv[Dim][Lanes::width] = {}, spread[Lanes::width] = {};
         Lanes::for_each_node([&](int k, const std::array<int, Dim>& a) {
@@ -1141,7 +1190,19 @@ void Solver<Dim>::gather_motion(double dt) {
           }
         });
         finish(start, lanes, v_pic, dv, spread, nullptr, census, lost, work, gained);
+        if constexpr (Move) {
+          ahead.compute(p.x.data(), p.half_width.data(), [start](int lane) { return start + lane; }, lanes);
+          outside += map_lanes(p, ahead, start, lanes, m, mv, reached, strides);
+        }
       });
+    }
+    if constexpr (Move) {
+      active_.collect();
+      clear_dropped();
+      mapped_ahead_ = true;
+      // A particle beyond the ghost nodes has left the grid: the census
+      // counted it, and its removal maps the rest again.
+      if (outside > 0) discard_mapping();
     }
   }
   if constexpr (Move) census_ = census;
@@ -1267,6 +1328,7 @@ void Solver<Dim>::remove_escaped(const Census& census, StepInfo& info) {
   for (std::size_t m = 0; m < materials_.size(); ++m)
     if (!leaving[m].empty()) dissipated_.left += materials_[m]->strain_energy(p, leaving[m]);
   p.keep(keep);
+  discard_mapping();
   info.removed = static_cast<std::size_t>(escaped);
   removed_ += info.removed;
   rebuild_material_groups();
@@ -1337,6 +1399,7 @@ std::optional<double> Solver<Dim>::settle(const Settling& stage, std::optional<d
   remove_supports();
   for (auto& v : particles_.v) v.setZero();
   for (auto& b : particles_.affine) b.setZero();
+  discard_mapping();
   fastest_ = 0;
   time_ = 0;
   steps_ = 0;
@@ -1367,6 +1430,7 @@ void Solver<Dim>::load(const checkpoint::In& in) {
     if (m < 0 || static_cast<std::size_t>(m) >= materials_.size())
       group.fail("material", fmt::format("material {} of a scene with {}", m, materials_.size()));
   particles_ = std::move(p);
+  discard_mapping();
   rebuild_material_groups();
   fastest_ = 0;
   time_ = in.number("time");
@@ -1406,6 +1470,7 @@ void Solver<Dim>::restore_state(const State& s) {
   platen_displacement_ = s.platen_displacement;
   const bool same_particles = s.particles.size() == particles_.size();
   particles_ = s.particles;
+  discard_mapping();
   fastest_ = 0;
   if (!same_particles) rebuild_material_groups();
 }

@@ -190,7 +190,7 @@ struct StepInfo {
 // Wall time the steps have spent in each of their parts, in seconds: where a
 // run's time goes, and which part a second thread speeds up.
 struct StepTimes {
-  double map = 0;     // particles to grid: mass and momentum scattered
+  double map = 0;     // particles to grid: mass and momentum scattered (under USF and FLIP/PIC, in `motion`)
   double grid = 0;    // the threads' copies summed, ghosts folded, velocities and update, walls, platens
   double stress = 0;  // velocity gradients, the stress update, nodal forces scattered
   double motion = 0;  // grid to particles: velocities, positions, the census
@@ -391,6 +391,11 @@ class Solver {
   // every thread of a parallel region.
   void clear_sums();
   void clear_dropped();  // zero the velocities where the mapping no longer reaches
+  // The grid's mass and momentum (the threads' copies not yet summed) are the
+  // particles' as they are now: USF's move mapped them for the next step.
+  // Whatever changes the particles between steps discards that mapping.
+  bool mapped_ahead_ = false;
+  void discard_mapping();
   // Nodes whose mass counts once (in the damping's work): not the ghosts
   // beyond a fixed or roller wall, whose share fold_ghosts moved inside.
   std::vector<char> counted_;
