@@ -457,6 +457,19 @@ def outburst_cost(rows):
     return lines
 
 
+@block("outburst to rest longer step", "cases/outburst/benchmark/outburst-benchmark-mapped-ahead.csv",
+       "cases/outburst/benchmark/outburst-benchmark-courant045.csv")
+def outburst_longer_step(shipped, longer):
+    """The run to rest at the shipped step and at a longer one (scripts/outburst-benchmark.py --set ...)."""
+    lines = ["| build | scene overrides | simulated [s] | MPM steps | wall [s] | solid [s] |", "|---|---|---|---|---|---|"]
+    for r in shipped + longer:
+        if r["case"] != "to_rest" or "mpm_steps" not in r:
+            continue
+        lines.append(f"| {r['build']} | {r['overrides'] or 'none (shipped)'} | {float(r['simulated_s']):.3g} | "
+                     f"{int(r['mpm_steps']):,} | {float(r['wall_s']):.1f} | {float(r['solid_s']):.1f} |")
+    return lines
+
+
 block("outburst cost after 3d", "cases/outburst/benchmark/outburst-benchmark-after-3d.csv")(outburst_cost)
 block("outburst cost stencil lanes", "cases/outburst/benchmark/outburst-benchmark-stencil-lanes.csv")(outburst_cost)
 block("mpm benchmark stencil lanes", "mpm_solid/benchmark/compare-63e0ffd-53491f2-b1c4128.csv")(mpm_benchmark_builds)
@@ -478,6 +491,8 @@ block("outburst cost active walls", "cases/outburst/benchmark/outburst-benchmark
 block("outburst cost gas lanes", "cases/outburst/benchmark/outburst-benchmark-gas-lanes.csv")(outburst_cost)
 block("mpm benchmark sliding lanes", "mpm_solid/benchmark/compare-63e0ffd-906bedb-145f429.csv")(mpm_benchmark_builds)
 block("outburst cost serial sliding", "cases/outburst/benchmark/outburst-benchmark-serial-sliding.csv")(outburst_cost)
+block("mpm benchmark mapped ahead", "mpm_solid/benchmark/compare-63e0ffd-87a87e7-46a287f.csv")(mpm_benchmark_builds)
+block("outburst cost mapped ahead", "cases/outburst/benchmark/outburst-benchmark-mapped-ahead.csv")(outburst_cost)
 
 
 @block("mpm benchmark", "mpm_solid/benchmark/mpm-benchmark.csv")

@@ -6,8 +6,10 @@ throughput (particle-steps per second of solid time, from coupling.csv and
 mpm_history.csv), beside mpm-benchmark's standalone throughput at the same
 particle count, shape and material (B-splines, elastic_damage) and threads.
 
-usage: scripts/outburst-benchmark.py [--threads 2] [--only first_second|to_rest] [--csv FILE] [--out DIR] NAME=BUILD_DIR ...
+usage: scripts/outburst-benchmark.py [--threads 2] [--only first_second|to_rest] [--set KEY=VALUE ...] [--csv FILE] [--out DIR] NAME=BUILD_DIR ...
   e.g. scripts/outburst-benchmark.py --csv results/outburst-benchmark.csv before=/tmp/old/build after=build
+--set adds a scene override (as the outburst program's --set) to every run, after the case's own: a
+longer step, say, costed against the shipped one's rows of another run.
 Run it on an idle machine: two threads that share their cores with other
 work wait on each other at every barrier.
 """
@@ -54,10 +56,10 @@ def standalone(build, particles, threads):
     sys.exit(f"{build}: mpm-benchmark printed no bspline elastic_damage row:\n{filtered.stdout}{filtered.stderr}")
 
 
-def run(build, case, threads, folder):
+def run(build, case, threads, folder, overrides):
     command = [os.path.join(build, "coupler", "outburst"), SCENE, "-q", "-o", folder, "--overwrite",
                "-j", str(threads)]
-    for o in CASES[case]:
+    for o in CASES[case] + overrides:
         command += ["--set", o]
     start = time.monotonic()
     subprocess.run(command, check=True, capture_output=True)
@@ -66,8 +68,11 @@ def run(build, case, threads, folder):
         windows = list(csv.DictReader(f))
     solid = sum(float(w["solid_s"]) for w in windows)
     steps = particle_steps(folder)
-    return {"wall_s": wall, "solid_s": solid, "simulated_s": float(windows[-1]["time"]),
-            "particles": int(windows[0]["particles"]), "coupled_particle_steps_per_s": steps / solid}
+    with open(os.path.join(folder, "mpm_history.csv")) as f:
+        mpm_steps = int(list(csv.DictReader(f))[-1]["step"])
+    return {"overrides": "; ".join(overrides), "wall_s": wall, "solid_s": solid,
+            "simulated_s": float(windows[-1]["time"]), "particles": int(windows[0]["particles"]),
+            "mpm_steps": mpm_steps, "coupled_particle_steps_per_s": steps / solid}
 
 
 def main():
@@ -75,6 +80,8 @@ def main():
     parser.add_argument("builds", nargs="+", help="NAME=BUILD_DIR, the first the reference")
     parser.add_argument("--threads", type=int, default=2)
     parser.add_argument("--only", choices=sorted(CASES))
+    parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                        help="a scene override for every run (repeatable)")
     parser.add_argument("--csv", help="also write the rows here")
     parser.add_argument("--out", help="keep the runs here, one folder per case and build (for their reports: "
                                       "python3 -m cases.outburst.report DIR/NAME_CASE)")
@@ -85,7 +92,7 @@ def main():
         scratch = args.out or temporary
         for case in [args.only] if args.only else list(CASES):
             for name, build in builds:
-                r = run(build, case, args.threads, os.path.join(scratch, f"{name}_{case}"))
+                r = run(build, case, args.threads, os.path.join(scratch, f"{name}_{case}"), args.overrides)
                 r["standalone_particle_steps_per_s"] = standalone(build, r["particles"], args.threads)
                 rows.append({"case": case, "build": name, "threads": args.threads} | r)
                 print(f"{case} {name}: {r['wall_s']:.1f} s wall for {r['simulated_s']:.3g} s, solid "
