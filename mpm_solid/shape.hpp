@@ -23,7 +23,8 @@ namespace outburst::mpm {
 // conversion is defined: the solver's stencils read the particles and
 // tracers a scene placed on the grid, and after each step only the
 // particles still on it (the census removes the ones that left and stops
-// the run at a non-finite position). Holding x there first cost every
+// the run at a non-finite position; the move's mapping ahead skips the
+// chunks the census found such a particle in). Holding x there first cost every
 // kernel 15 % (mpm_solid/benchmark/compare-63e0ffd-de26bb6-290380f-e0a5804.csv):
 // GCC 12 sinks the conversion into the select's branches, where it may
 // trap, and keeps the stencils' loops scalar again. Near int's ends one

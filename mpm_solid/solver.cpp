@@ -713,8 +713,9 @@ template <class Shape>
 void Solver<Dim>::update_and_scatter(double dt) {
   auto& p = particles_;
   const ForceTerms<Dim> terms = force_terms(p, settings_);
-  // force_ is zero: clear_sums zeroed it, and the pointwise update runs
-  // without smooth_dilatation, the one pass that borrows it before the forces.
+  // force_ is zero: clear_sums zeroed it (in this step's mapping, or the last
+  // step's move when it mapped ahead), and the pointwise update runs without
+  // smooth_dilatation, the one pass that borrows it before the forces.
   Scatter<Vec<Dim>> forces{thread_vector_, force_, active_.runs()};
   double plastic = 0, damage = 0;
 #pragma omp parallel num_threads(threads_) reduction(+ : plastic, damage)
@@ -1189,10 +1190,19 @@ void Solver<Dim>::gather_motion(double dt) {
             spread[lane] += weight * squared;
           }
         });
+        const long troubled = census.bad + census.runaway;
         finish(start, lanes, v_pic, dv, spread, nullptr, census, lost, work, gained);
         if constexpr (Move) {
-          ahead.compute(p.x.data(), p.half_width.data(), [start](int lane) { return start + lane; }, lanes);
-          outside += map_lanes(p, ahead, start, lanes, m, mv, reached, strides);
+          // A chunk the census found a non-finite or runaway particle in is
+          // not mapped (its positions may lie beyond int's range, where the
+          // stencils' floor is undefined): the step throws, and a caller
+          // that steps on maps afresh.
+          if (census.bad + census.runaway > troubled) {
+            outside += lanes;
+          } else {
+            ahead.compute(p.x.data(), p.half_width.data(), [start](int lane) { return start + lane; }, lanes);
+            outside += map_lanes(p, ahead, start, lanes, m, mv, reached, strides);
+          }
         }
       });
     }
@@ -1200,8 +1210,8 @@ void Solver<Dim>::gather_motion(double dt) {
       active_.collect();
       clear_dropped();
       mapped_ahead_ = true;
-      // A particle beyond the ghost nodes has left the grid: the census
-      // counted it, and its removal maps the rest again.
+      // A particle beyond the ghost nodes has left the grid (the census
+      // counted it, and its removal maps the rest again) or gone wrong.
       if (outside > 0) discard_mapping();
     }
   }

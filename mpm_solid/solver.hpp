@@ -4,7 +4,8 @@
 //
 // One step (update-stress-first, the paper's section 3; USL and MUSL move the
 // stress update after the grid update):
-//   1. particles -> grid: mass and momentum
+//   1. particles -> grid: mass and momentum (under USF with the FLIP/PIC
+//      blend, mapped by the last step's 6, unless the particles changed since)
 //   2. grid velocities, walls applied
 //   3. grid -> particles: velocity gradient; materials update stress (Jaumann)
 //   4. particles -> grid: internal force, gravity, external forces
@@ -303,11 +304,14 @@ class Solver {
   // speed.
   const std::vector<double>& platen_force() const { return platen_force_; }
 
-  // The grid nodes the last step's passes ran over (ActiveBlocks).
+  // The grid nodes of the last mapping's active blocks (ActiveBlocks): those
+  // the next step's passes run over when USF's move mapped ahead, else those
+  // the last step's ran over.
   std::size_t active_nodes() const { return active_.active_nodes(); }
   // Nonzero nodal values outside those nodes, and in the threads' scatter
-  // buffers anywhere: none between steps, the invariant the grid's passes
-  // rely on (checked by the tests).
+  // buffers anywhere (on those nodes, when mapped ahead, the next step's
+  // sums): none between steps, the invariant the grid's passes rely on
+  // (checked by the tests).
   std::size_t stray_nodal_values() const;
 
   // Memory held now [bytes]: by the particles (every field, and the per-step

@@ -132,9 +132,10 @@ struct StencilLanes {
   // Lanes 0 .. lanes-1 from particles particle(0), particle(1), ... of the
   // positions x and half-widths (in cells). inside() says whether each
   // lane's support lies in the ghost-padded grid: where it does not, first
-  // and offset point outside the nodal arrays. A step's first pass (the mass
-  // scatter) refuses such particles, and positions change only at its end,
-  // so the passes after it read and write the nodes unchecked.
+  // and offset point outside the nodal arrays. The mass scatter (a step's
+  // first pass, or the last step's move mapping ahead) refuses such
+  // particles, and positions change only at a step's end, so the passes
+  // after it read and write the nodes unchecked.
   template <class Index>
   void compute(const Vec<Dim>* x, const double* half_width, Index particle, int lanes) {
     // Locals: read through the lattice, these would be loaded again for
