@@ -491,6 +491,7 @@ block("outburst cost active walls", "cases/outburst/benchmark/outburst-benchmark
 block("outburst cost gas lanes", "cases/outburst/benchmark/outburst-benchmark-gas-lanes.csv")(outburst_cost)
 block("mpm benchmark sliding lanes", "mpm_solid/benchmark/compare-63e0ffd-906bedb-145f429.csv")(mpm_benchmark_builds)
 block("outburst cost serial sliding", "cases/outburst/benchmark/outburst-benchmark-serial-sliding.csv")(outburst_cost)
+block("mpm benchmark chunk lanes", "mpm_solid/benchmark/compare-chunk-lanes-16-8-32.csv")(mpm_benchmark_builds)
 block("mpm benchmark mapped ahead", "mpm_solid/benchmark/compare-63e0ffd-87a87e7-46a287f.csv")(mpm_benchmark_builds)
 block("outburst cost mapped ahead", "cases/outburst/benchmark/outburst-benchmark-mapped-ahead.csv")(outburst_cost)
 
