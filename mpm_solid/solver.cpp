@@ -554,13 +554,11 @@ template <int Dim>
 void Solver<Dim>::discard_mapping() {
   if (!mapped_ahead_) return;
   mapped_ahead_ = false;
-  Scatter<double> masses{thread_mass_, mass_, active_.runs()};
-  Scatter<Vec<Dim>> momenta{thread_vector_, momentum_, active_.runs()};
   over_nodes(active_.runs(), [&](std::size_t i) {
-    masses.gather(i);
-    momenta.gather(i);
     mass_[i] = 0;
     momentum_[i] = Vec<Dim>::Zero();
+    for (auto& t : thread_mass_) t[i] = 0;
+    for (auto& t : thread_vector_) t[i] = Vec<Dim>::Zero();
   });
 }
 

@@ -19,6 +19,16 @@ struct ThreadsFor {
   ~ThreadsFor() { omp_set_num_threads(before); }
 };
 
+// The same particles, bit for bit: positions, velocities and stresses.
+void require_same(const Particles<2>& a, const Particles<2>& b) {
+  REQUIRE(a.size() == b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    REQUIRE(a.x[i] == b.x[i]);
+    REQUIRE(a.v[i] == b.v[i]);
+    REQUIRE(a.stress[i] == b.stress[i]);
+  }
+}
+
 struct Run {
   Particles<2> particles;
   Energies energies;
@@ -56,12 +66,7 @@ TEST_CASE("a body on a wider, empty grid moves bit for bit as on a narrow one, o
   // differently and the sums round differently.
   const ThreadsFor one(1);
   const Run narrow = drop(4.0, shape, scheme), wide = drop(16.0, shape, scheme);
-  REQUIRE(narrow.particles.size() == wide.particles.size());
-  for (std::size_t i = 0; i < narrow.particles.size(); ++i) {
-    REQUIRE(narrow.particles.x[i] == wide.particles.x[i]);
-    REQUIRE(narrow.particles.v[i] == wide.particles.v[i]);
-    REQUIRE(narrow.particles.stress[i] == wide.particles.stress[i]);
-  }
+  require_same(narrow.particles, wide.particles);
   CHECK(narrow.energies.total() == wide.energies.total());
   CHECK(narrow.energies.walls == wide.energies.walls);
   INFO("active nodes " << narrow.active_nodes << " of " << narrow.grid_nodes << " and " << wide.active_nodes
@@ -137,15 +142,6 @@ Solver<2> thrown(ShapeKind shape) {
   s.gravity = {0, -9.81};
   s.walls = {Wall{Wall::Type::fixed}, Wall{}, Wall{Wall::Type::fixed}, Wall{}};
   return Solver<2>(g, elastic({1000, 1e7, 0.3}), std::move(p), s);
-}
-
-void require_same(const Particles<2>& a, const Particles<2>& b) {
-  REQUIRE(a.size() == b.size());
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    REQUIRE(a.x[i] == b.x[i]);
-    REQUIRE(a.v[i] == b.v[i]);
-    REQUIRE(a.stress[i] == b.stress[i]);
-  }
 }
 
 }  // namespace
