@@ -4,8 +4,13 @@ ROUNDS times each on one thread, and prints each row's best throughput per
 build and its ratio to the first build's. Single runs on a shared machine
 land in a fast or a slow mode, so the best of the rounds is compared, the
 builds interleaved so that a load on the machine falls on all of them.
+Builds whose mpm-benchmark measures one row at a time (--shape and
+--material, from 5e08b15 on) take turns row by row, a second apart: a slow
+spell of the machine then falls on all of them, where whole runs, a minute
+apart, could catch it in one build's run alone. --cpu pins every run to one
+core (on this kind of machine the two cores' speeds differ at times).
 
-usage: compare-mpm-benchmark.py [--particles N] [--rounds R] [--dimension 2|3] [--csv FILE] NAME=BUILD_DIR ...
+usage: compare-mpm-benchmark.py [--particles N] [--rounds R] [--dimension 2|3] [--cpu C] [--csv FILE] NAME=BUILD_DIR ...
   e.g. compare-mpm-benchmark.py before=/tmp/old/build after=build
 """
 import argparse
@@ -20,18 +25,33 @@ from builds import named_builds  # scripts/builds.py
 ROW = re.compile(r"^\s*(\d+)\s+(\S+)\s+(\S+)\s+([0-9.e+]+)")
 
 
-def run(build, particles, dimension):
-    program = os.path.join(build, "mpm_solid", "mpm-benchmark")
+def program(build):
+    return os.path.join(build, "mpm_solid", "mpm-benchmark")
+
+
+def by_rows(build):
+    """Whether the build's mpm-benchmark measures a row alone."""
+    shown = subprocess.run([program(build), "--help"], capture_output=True, text=True)
+    return "--material" in shown.stdout
+
+
+def run(build, particles, dimension, cpu, row=None, threads=()):
     plane = dimension == 2  # builds from before 3D take no --dimension
-    out = subprocess.run([program, str(particles)] + ([] if plane else ["--dimension", "3"]), check=True, capture_output=True, text=True,
-                         env=dict(os.environ, OMP_NUM_THREADS="1")).stdout
+    command = [program(build)] + ([] if plane else ["--dimension", "3"]) + list(threads)
+    if row:
+        command += ["--shape", row[0], "--material", row[1], "--threads", "1"]
+    if row or threads:
+        command += ["--"]
+    out = subprocess.run(command + [str(particles)], check=True, capture_output=True, text=True,
+                         env=dict(os.environ, OMP_NUM_THREADS="1"),
+                         preexec_fn=None if cpu is None else lambda: os.sched_setaffinity(0, {cpu})).stdout
     rows = {}
     for line in out.splitlines():
         m = ROW.match(line)
         if m:
             rows[(m.group(2), m.group(3))] = float(m.group(4))
     if not rows:
-        sys.exit(f"{program} printed no benchmark rows:\n{out}")
+        sys.exit(f"{program(build)} printed no benchmark rows:\n{out}")
     return rows
 
 
@@ -42,14 +62,31 @@ def main():
     parser.add_argument("--rounds", type=int, default=5)
     parser.add_argument("--dimension", type=int, choices=(2, 3), default=2,
                         help="3: the 3D kernel (builds from 53491f2 on)")
+    parser.add_argument("--cpu", type=int, help="pin every run to this core")
     parser.add_argument("--csv", help="also write the table here")
     args = parser.parse_args()
+    if args.cpu is not None and args.cpu not in os.sched_getaffinity(0):
+        sys.exit(f"--cpu {args.cpu}: this process may run on cores {sorted(os.sched_getaffinity(0))} only")
     builds = named_builds(args.builds, os.path.join("mpm_solid", "mpm-benchmark"))
+    rowwise = [(name, folder) for name, folder in builds if by_rows(folder)]
+    whole = [(name, folder) for name, folder in builds if (name, folder) not in rowwise]
     best = {name: {} for name, _ in builds}
+
+    def book(name, rows):
+        for row, value in rows.items():
+            best[name][row] = max(best[name].get(row, 0.0), value)
+
+    rows = []
     for r in range(args.rounds):
-        for name, folder in builds:
-            for row, value in run(folder, args.particles, args.dimension).items():
-                best[name][row] = max(best[name].get(row, 0.0), value)
+        for name, folder in whole:
+            book(name, run(folder, args.particles, args.dimension, args.cpu))
+        if rowwise:
+            # The rows the first such build measures by default (found once,
+            # not booked), each then by every such build in turn.
+            rows = rows or list(run(rowwise[0][1], args.particles, args.dimension, args.cpu, threads=["--threads", "1"]))
+            for row in rows:
+                for name, folder in rowwise:
+                    book(name, run(folder, args.particles, args.dimension, args.cpu, row))
         print(f"round {r + 1} of {args.rounds} done", file=sys.stderr)
     reference = builds[0][0]
     header = ["shape", "material"] + [f"{n} [particle-steps/s]" for n, _ in builds] + \
@@ -58,7 +95,8 @@ def main():
     for row in best[reference]:
         values = [best[n].get(row, float("nan")) for n, _ in builds]
         rows.append(list(row) + [f"{v:.4g}" for v in values] + [f"{v / values[0]:.3f}" for v in values[1:]])
-    print(f"best of {args.rounds} rounds, {args.particles} particles, 1 thread, {args.dimension}D")
+    pinned = "" if args.cpu is None else f", on core {args.cpu}"
+    print(f"best of {args.rounds} rounds, {args.particles} particles, 1 thread{pinned}, {args.dimension}D")
     print("| " + " | ".join(header) + " |")
     print("|" + "---|" * len(header))
     for r in rows:
