@@ -493,6 +493,7 @@ block("mpm benchmark sliding lanes", "mpm_solid/benchmark/compare-63e0ffd-906bed
 block("outburst cost serial sliding", "cases/outburst/benchmark/outburst-benchmark-serial-sliding.csv")(outburst_cost)
 block("mpm benchmark chunk lanes", "mpm_solid/benchmark/compare-chunk-lanes-16-8-32.csv")(mpm_benchmark_builds)
 block("mpm benchmark mapped ahead", "mpm_solid/benchmark/compare-63e0ffd-87a87e7-46a287f.csv")(mpm_benchmark_builds)
+block("mpm benchmark gradients in lanes", "mpm_solid/benchmark/compare-63e0ffd-c3795f7-lanes.csv")(mpm_benchmark_builds)
 block("outburst cost mapped ahead", "cases/outburst/benchmark/outburst-benchmark-mapped-ahead.csv")(outburst_cost)
 
 

@@ -13,7 +13,7 @@ double Elasticity::p_wave_speed() const {
 
 template <int Dim>
 Dissipation Material<Dim>::update_stress(Particles<Dim>& p, const std::vector<int>& members, double dt) const {
-  return over_chunks(members, [&](std::span<const int> part) { return update_chunk(p, part, dt); });
+  return over_chunks(members, [&](std::span<const int> part) { return update_chunk(p, part, dt, nullptr); });
 }
 
 template <int Dim>

@@ -84,11 +84,13 @@ class Material {
   // update reads other particles (a nonlocal average) overrides this.
   virtual Dissipation update_stress(Particles<Dim>& p, const std::vector<int>& members, double dt) const;
 
-  // The same for a few particles, serially, for a pointwise() material: the
-  // solver calls it from inside its own parallel pass, between gathering the
-  // chunk's velocity gradients and scattering its forces, while the chunk's
-  // fields are still in cache.
-  virtual Dissipation update_chunk(Particles<Dim>& p, std::span<const int> members, double dt) const = 0;
+  // The same for a few particles (at most chunk_size), serially, for a
+  // pointwise() material: the solver calls it from inside its own parallel
+  // pass, between gathering the chunk's velocity gradients and scattering
+  // its forces, while the chunk's fields are still in cache. `gradients`:
+  // where the members' velocity gradients are (ChunkGradients).
+  virtual Dissipation update_chunk(Particles<Dim>& p, std::span<const int> members, double dt,
+                                   const double* gradients) const = 0;
   // Whether a particle's update reads only its own fields.
   virtual bool pointwise() const { return true; }
 
@@ -149,6 +151,19 @@ template <int Dim>
     return none;
 }
 
+// Particles per chunk of a pass that runs a material's update between
+// other work on the same particles: a chunk's fields and stencils stay in
+// the first cache levels (64 quadratic B-spline stencils, as StencilLanes
+// holds them, take 7 kB in the plane and 11 kB in 3D).
+inline constexpr int chunk_size = 64;
+
+// Where a stress update reads the velocity gradients of a chunk's members:
+// null, each particle's own p.velocity_gradient (the solver's split passes
+// store it); else a chunk's, one SIMD lane per member, entry e = r + Dim c
+// (Eigen's order) of member k at gradients[e * chunk_size + k]. The fused
+// pass keeps them so, out of the particles' arrays, whose stores were a
+// measurable share of its step (README.md, The MPM solver).
+
 // f(std::integral_constant<int, 0>{}), ..., f(std::integral_constant<int, N - 1>{}):
 // a small loop written out at compile time.
 template <int N, class F>
@@ -182,10 +197,10 @@ template <int N, class F>
 // slower. The 3D order is Eigen's too, but for the Jaumann rotation's
 // products, which Eigen fused in some contexts and not in others: a few
 // stress entries moved by an ulp.
-template <int Dim, class Index, class Stiffness>
+template <int Dim, class Index, class Stiffness, class Gradient>
 [[gnu::always_inline]] inline void deform_and_trial(Particles<Dim>& p, int n, Index index, Stiffness stiffness,
-                                                    double dt, double lambda, double shear, Mat<Dim>* stress,
-                                                    double* stress_zz) {
+                                                    Gradient gradient, double dt, double lambda, double shear,
+                                                    Mat<Dim>* stress, double* stress_zz) {
   constexpr int entries = Dim * Dim;
   // Entry e = r + Dim c of a matrix is (r, c): Eigen's column-major order,
   // and the matrices of a field follow each other unpadded.
@@ -196,7 +211,6 @@ template <int Dim, class Index, class Stiffness>
   // the volumes' base was loaded again in the loop, and GCC loaded and
   // stored them by gathers and scatters (a sixth of the elastic trial's
   // time, perf).
-  double* const l_all = p.velocity_gradient.data()->data();
   double* const f_all = p.deformation.data()->data();
   double* const s_all = stress->data();
   double* const volume = p.volume.data();
@@ -206,7 +220,8 @@ template <int Dim, class Index, class Stiffness>
     // Straight-line code (the small loops written out at compile time): GCC
     // vectorises it over the particles where it leaves nested loops alone.
     const std::ptrdiff_t i = index(k);
-    const double* l = l_all + entries * i;
+    double l[entries];
+    unrolled<entries>([&](auto e) { l[e] = gradient(k, i, e); });
     double* f = f_all + entries * i;
     double* s = s_all + entries * i;
     // F <- (I + dt L) F as Eigen forms it: a column's leading pair of rows
@@ -275,20 +290,34 @@ template <class F>
 // The same over a chunk of a material's members, in increasing order, none
 // twice (as material_members lists them): the lanes write each its own
 // particle.
+// The members' velocity gradients as `gradients` says (null: their own;
+// see chunk_size), and at most chunk_size members when they are a chunk's.
 template <int Dim>
 void deform_and_trial(Particles<Dim>& p, std::span<const int> members, double dt, double lambda, double shear,
                       const std::vector<double>* stiffness, std::vector<Mat<Dim>>& stress,
-                      std::vector<double>& stress_zz) {
+                      std::vector<double>& stress_zz, const double* gradients = nullptr) {
   assert(std::adjacent_find(members.begin(), members.end(), std::greater_equal<>()) == members.end());
+  assert(!gradients || members.size() <= static_cast<std::size_t>(chunk_size));
   if (members.empty()) return;
   const int n = static_cast<int>(members.size());
   double* zz = Dim == 2 ? stress_zz.data() : nullptr;
+  const auto with_gradients = [&](auto index, auto scale) __attribute__((always_inline)) {
+    if (gradients) {
+      deform_and_trial(
+          p, n, index, scale, [gradients](int k, std::ptrdiff_t, int e) { return gradients[e * chunk_size + k]; },
+          dt, lambda, shear, stress.data(), zz);
+    } else {
+      const double* own = p.velocity_gradient.data()->data();
+      deform_and_trial(
+          p, n, index, scale, [own](int, std::ptrdiff_t i, int e) { return own[Dim * Dim * i + e]; }, dt, lambda,
+          shear, stress.data(), zz);
+    }
+  };
   by_position(members, [&](auto index) {
     if (stiffness)
-      deform_and_trial(p, n, index, [scale = stiffness->data()](std::ptrdiff_t i) { return scale[i]; }, dt, lambda,
-                       shear, stress.data(), zz);
+      with_gradients(index, [scale = stiffness->data()](std::ptrdiff_t i) { return scale[i]; });
     else
-      deform_and_trial(p, n, index, [](std::ptrdiff_t) { return 1.0; }, dt, lambda, shear, stress.data(), zz);
+      with_gradients(index, [](std::ptrdiff_t) { return 1.0; });
   });
 }
 
@@ -363,12 +392,6 @@ inline double drucker_prager_return(double alpha, double k, double alpha_dilatio
   if (work_density) *work_density = sqrt_j2 * (inv.sqrt_j2 - sqrt_j2) / g + mean * (inv.mean - mean) / bulk;
   return dlambda;
 }
-
-// Particles per chunk of a pass that runs a material's update between
-// other work on the same particles: a chunk's fields and stencils stay in
-// the first cache levels (64 quadratic B-spline stencils, as StencilLanes
-// holds them, take 7 kB in the plane and 11 kB in 3D).
-inline constexpr int chunk_size = 64;
 
 // Runs update(i), what remains of particle i's stress update after
 // deform_and_trial, returning what it dissipated, over `members` in turn.

@@ -26,7 +26,10 @@ struct Particles {
   std::vector<double> half_width;           // initial half-width in cells (GIMP)
   std::vector<Mat<Dim>> stress;             // Cauchy, tension positive [Pa]
   std::vector<double> stress_zz;            // out-of-plane stress (plane strain; 3D: absent)
-  std::vector<Mat<Dim>> velocity_gradient;  // L = grad v of the last step [1/s]
+  // L = grad v [1/s] of the last step that stored it: the split passes
+  // (MUSL, USL, smoothed dilatation, nonlocal damage). USF's fused pass keeps
+  // each chunk's in SIMD lanes instead (chunk_size, material.hpp).
+  std::vector<Mat<Dim>> velocity_gradient;
   std::vector<Mat<Dim>> deformation;        // F
   std::vector<Mat<Dim>> affine;             // APIC's B matrix
   std::vector<std::int32_t> material;       // index into the scene's materials

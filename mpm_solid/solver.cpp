@@ -103,13 +103,16 @@ template <int Dim, class Shape, int Width, class F>
 }
 
 // L = grad v from the grid's velocities at the particles of a chunk's
-// lanes, into gradient[particle(lane)].
-template <int Dim, class Shape, int Width, class Index>
+// lanes: d v_b / d x_d of lane `lane` at l[d][b][lane], each lane's entries
+// in Eigen's order (entry e = b + Dim d at l[0][0] + e * Width).
+template <int Dim, class Shape, int Width>
 [[gnu::always_inline]] inline void velocity_gradients(const std::vector<Vec<Dim>>& velocity,
                                                       const StencilLanes<Dim, Shape, Width>& s, int lanes,
-                                                      Index particle, std::vector<Mat<Dim>>& gradient) {
+                                                      double (&out)[Dim][Dim][Width]) {
   const double* nodal = velocity.data()->data();
-  alignas(64) double l[Dim][Dim][Width] = {};  // d v_b / d x_d
+  // Summed in a local: in `out` the sums were loaded and stored again at
+  // every node, as the nodal velocities might alias it.
+  alignas(64) double l[Dim][Dim][Width] = {};
   s.for_each_node([&](int k, const std::array<int, Dim>& a) {
     const std::ptrdiff_t offset = s.offset[k];
 #pragma omp simd
@@ -119,15 +122,11 @@ template <int Dim, class Shape, int Width, class Index>
       for (int d = 0; d < Dim; ++d) {
         const double g = s.gradient(d, a, lane);
 #pragma GCC unroll 3
-        for (int b = 0; b < Dim; ++b) l[b][d][lane] += v[b] * g;
+        for (int b = 0; b < Dim; ++b) l[d][b][lane] += v[b] * g;
       }
     }
   });
-  for (int lane = 0; lane < lanes; ++lane) {
-    Mat<Dim>& out = gradient[particle(lane)];
-    for (int b = 0; b < Dim; ++b)
-      for (int d = 0; d < Dim; ++d) out(b, d) = l[b][d][lane];
-  }
+  std::copy_n(&l[0][0][0], Dim * Dim * Width, &out[0][0][0]);
 }
 
 // Scatters the mass and momentum of particles start .. start + lanes - 1,
@@ -623,7 +622,13 @@ void Solver<Dim>::gather_velocity_gradient() {
     const Lattice<Dim> lattice(grid_);
     StencilLanes<Dim, Shape> s(lattice);
     over_chunks(s, p, [&](int start, int lanes) {
-      velocity_gradients(velocity_, s, lanes, [start](int lane) { return start + lane; }, p.velocity_gradient);
+      alignas(64) double l[Dim][Dim][decltype(s)::width];
+      velocity_gradients(velocity_, s, lanes, l);
+      for (int lane = 0; lane < lanes; ++lane) {
+        Mat<Dim>& out = p.velocity_gradient[start + lane];
+        for (int b = 0; b < Dim; ++b)
+          for (int d = 0; d < Dim; ++d) out(b, d) = l[d][b][lane];
+      }
     });
   }
 }
@@ -705,7 +710,9 @@ void Solver<Dim>::scatter_forces() {
 // (mpm_solid/benchmark/compare-c88bc1c-fused.csv) and under linear shapes,
 // whose stencils cost little to compute again, once the materials' trial ran
 // over lanes (compare-fused-linear-b53d828.csv; before, no faster:
-// compare-lanes-fused-linear.csv).
+// compare-lanes-fused-linear.csv). The chunk's velocity gradients stay in
+// its lanes (see chunk_size), so the pore pressure's work, which reads them,
+// is booked here rather than in the census.
 template <int Dim>
 template <class Shape>
 void Solver<Dim>::update_and_scatter(double dt) {
@@ -715,8 +722,8 @@ void Solver<Dim>::update_and_scatter(double dt) {
   // step's move when it mapped ahead), and the pointwise update runs without
   // smooth_dilatation, the one pass that borrows it before the forces.
   Scatter<Vec<Dim>> forces{thread_vector_, force_, active_.runs()};
-  double plastic = 0, damage = 0;
-#pragma omp parallel num_threads(threads_) reduction(+ : plastic, damage)
+  double plastic = 0, damage = 0, pore_work = 0;
+#pragma omp parallel num_threads(threads_) reduction(+ : plastic, damage, pore_work)
   {
     auto& f = forces.buffer(omp_get_thread_num());
     const Lattice<Dim> lattice(grid_);
@@ -735,10 +742,20 @@ void Solver<Dim>::update_and_scatter(double dt) {
         // and scatters, the positions' gather the pass's hottest instruction.
         by_position(chunk, [&](auto particle) __attribute__((always_inline)) {
           s.compute(p.x.data(), p.half_width.data(), particle, lanes);
-          velocity_gradients(velocity_, s, lanes, particle, p.velocity_gradient);
-          const Dissipation d = materials_[m]->update_chunk(p, chunk, dt);
+          alignas(64) double l[Dim][Dim][chunk_size];
+          velocity_gradients(velocity_, s, lanes, l);
+          const Dissipation d = materials_[m]->update_chunk(p, chunk, dt, &l[0][0][0]);
           plastic += d.plastic;
           damage += d.damage;
+          // A pore pressure does work on the skeleton as it dilates (at
+          // the volume the update left, as the census books it).
+          if (terms.pore)
+            for (int lane = 0; lane < lanes; ++lane) {
+              const auto i = particle(lane);
+              double dilatation = l[0][0][lane];
+              for (int e = 1; e < Dim; ++e) dilatation += l[e][e][lane];
+              pore_work += terms.pore[i] * p.volume[i] * dilatation * dt;
+            }
           for (int lane = 0; lane < lanes; ++lane) add_forces(p, terms, static_cast<int>(particle(lane)), s, lane, f);
         });
       }
@@ -746,6 +763,7 @@ void Solver<Dim>::update_and_scatter(double dt) {
   }
   dissipated_.plastic += plastic;
   dissipated_.damage += damage;
+  dissipated_.external += pore_work;
 }
 
 // The threads' copies of the force are summed first. Without local damping
@@ -959,13 +977,16 @@ template <class M>
 }  // namespace
 
 // Books the moved particles start .. start + lanes - 1: the work of a pore
-// pressure on them, whether they went wrong or left, and the fastest signal
+// pressure on them (with_pore_work: where the step stored their velocity
+// gradients; the fused pass books it itself), whether they went wrong or
+// left, and the fastest signal
 // among those that moved well (finite, on the grid and below their runaway
 // speed), which sets the next step. Over SIMD lanes, the work then summed
 // particle by particle, in order; the other books are counts and a maximum,
 // which no order changes.
 template <int Dim>
-[[gnu::always_inline]] inline void Solver<Dim>::count(int start, int lanes, double dt, Census& census) const {
+[[gnu::always_inline]] inline void Solver<Dim>::count(int start, int lanes, double dt, bool with_pore_work,
+                                                      Census& census) const {
   const auto& p = particles_;
   constexpr int most = chunk_lanes;
   assert(lanes <= most);
@@ -1009,7 +1030,7 @@ template <int Dim>
       if (finite & inside & !fast & (speed > fastest)) fastest = speed;
     }
   };
-  const bool pore = !lean_build && !p.pore_pressure.empty();
+  const bool pore = !lean_build && with_pore_work && !p.pore_pressure.empty();
   with_draws(p, [&](auto drawn) __attribute__((always_inline)) {
     if (pore)
       over_lanes(std::true_type{}, drawn);
@@ -1106,7 +1127,7 @@ void Solver<Dim>::gather_motion(double dt) {
       lost += loss[lane];
       lost += blend[lane];
     }
-    if constexpr (Move) count(start, lanes, dt, census);
+    if constexpr (Move) count(start, lanes, dt, !pointwise_, census);  // pointwise: the fused pass ran
   };
   if constexpr (Apic) {
 #pragma omp parallel reduction(merge : census) reduction(+ : lost, work, gained)
@@ -1289,7 +1310,7 @@ Census Solver<Dim>::move_particles(double dt) {
   for (int c = 0; c < chunks; ++c) {
     const int start = c * width, end = std::min(n, start + width);
     for (int i = start; i < end; ++i) p.x[i] += displacement_[i];
-    count(start, end - start, dt, census);
+    count(start, end - start, dt, true, census);
   }
   return census;
 }

@@ -27,10 +27,12 @@ double DruckerPrager<Dim>::return_map(Mat<Dim>& s, double& s_zz, double* work_de
 }
 
 template <int Dim>
-Dissipation DruckerPrager<Dim>::update_chunk(Particles<Dim>& p, std::span<const int> members, double dt) const {
+Dissipation DruckerPrager<Dim>::update_chunk(Particles<Dim>& p, std::span<const int> members, double dt,
+                                             const double* gradients) const {
   // Equivalent plastic strain per unit multiplier: sqrt(2/3 |dg/dsigma|^2).
   const double strain_per_multiplier = std::sqrt(2.0 / 3.0 * (0.5 + alpha_dilation_ * alpha_dilation_ / 3));
-  deform_and_trial(p, members, dt, this->lame_lambda(), this->shear_modulus(), nullptr, p.stress, p.stress_zz);
+  deform_and_trial(p, members, dt, this->lame_lambda(), this->shear_modulus(), nullptr, p.stress, p.stress_zz,
+                   gradients);
   return each_member(members, [&](int i) {
     double none = 0;
     double& zz = out_of_plane<Dim>(p.stress_zz, i, none);

@@ -14,7 +14,8 @@ class DruckerPrager final : public Material<Dim> {
   DruckerPrager(std::string name, Elasticity elasticity, double cohesion, double friction_angle,
                 double dilation_angle, DruckerPragerFit::Kind fit);
   void create_fields(Particles<Dim>& p, const std::vector<int>&) const override { p.need_plastic_strain(); }
-  Dissipation update_chunk(Particles<Dim>& p, std::span<const int> members, double dt) const override;
+  Dissipation update_chunk(Particles<Dim>& p, std::span<const int> members, double dt,
+                           const double* gradients) const override;
 
   double alpha() const { return alpha_; }
   double k() const { return k_; }

@@ -3,8 +3,10 @@
 namespace outburst::mpm {
 
 template <int Dim>
-Dissipation LinearElastic<Dim>::update_chunk(Particles<Dim>& p, std::span<const int> members, double dt) const {
-  deform_and_trial(p, members, dt, this->lame_lambda(), this->shear_modulus(), nullptr, p.stress, p.stress_zz);
+Dissipation LinearElastic<Dim>::update_chunk(Particles<Dim>& p, std::span<const int> members, double dt,
+                                             const double* gradients) const {
+  deform_and_trial(p, members, dt, this->lame_lambda(), this->shear_modulus(), nullptr, p.stress, p.stress_zz,
+                   gradients);
   return {};
 }
 

@@ -8,7 +8,8 @@ template <int Dim>
 class LinearElastic final : public Material<Dim> {
  public:
   using Material<Dim>::Material;
-  Dissipation update_chunk(Particles<Dim>& p, std::span<const int> members, double dt) const override;
+  Dissipation update_chunk(Particles<Dim>& p, std::span<const int> members, double dt,
+                           const double* gradients) const override;
 };
 
 }  // namespace outburst::mpm

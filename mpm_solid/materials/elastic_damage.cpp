@@ -310,11 +310,12 @@ double ElasticDamage<Dim>::modulus_scale(const Particles<Dim>& p, int i) const {
 }
 
 template <int Dim>
-void ElasticDamage<Dim>::trial(Particles<Dim>& p, std::span<const int> members, double dt) const {
+void ElasticDamage<Dim>::trial(Particles<Dim>& p, std::span<const int> members, double dt,
+                               const double* gradients) const {
   // lambda and G scale with E
   deform_and_trial(p, members, dt, this->lame_lambda(), this->shear_modulus(),
                    parameters_.heterogeneity ? &p.modulus_scale : nullptr, p.effective_stress,
-                   p.effective_stress_zz);
+                   p.effective_stress_zz, gradients);
 }
 
 // The acting stress at damage d, what the growth of damage took, and the
@@ -378,9 +379,10 @@ Dissipation ElasticDamage<Dim>::settle(Particles<Dim>& p, int i, double d, const
 }
 
 template <int Dim>
-Dissipation ElasticDamage<Dim>::update_chunk(Particles<Dim>& p, std::span<const int> members, double dt) const {
+Dissipation ElasticDamage<Dim>::update_chunk(Particles<Dim>& p, std::span<const int> members, double dt,
+                                             const double* gradients) const {
   if (!pointwise()) throw std::logic_error("nonlocal damage updates a material's particles together (update_stress)");
-  trial(p, members, dt);
+  trial(p, members, dt, gradients);
   if constexpr (Dim == 2) {
     // The solver's chunks are chunk_size long; a longer call in pieces of it,
     // the lanes' verdicts' length.
@@ -520,7 +522,7 @@ Dissipation ElasticDamage<Dim>::update_stress(Particles<Dim>& p, const std::vect
   // Nonlocal: every member's trial stress and driving strain first, then
   // their averages over the internal length, then the damage.
   over_chunks(members, [&](std::span<const int> part) {
-    trial(p, part, dt);
+    trial(p, part, dt, nullptr);
     return each_member(part, [&](int i) {
       const double zz = Dim == 2 ? p.effective_stress_zz[i] : 0.0;
       p.nonlocal_strain[i] = driving_strain(p.effective_stress[i], zz, strength_scale(p, i), modulus_scale(p, i));

@@ -110,7 +110,8 @@ class ElasticDamage final : public Material<Dim> {
   ElasticDamage(std::string name, Elasticity elasticity, DamageParameters damage);
   void create_fields(Particles<Dim>& p, const std::vector<int>& members) const override;
   Dissipation update_stress(Particles<Dim>& p, const std::vector<int>& members, double dt) const override;
-  Dissipation update_chunk(Particles<Dim>& p, std::span<const int> members, double dt) const override;
+  Dissipation update_chunk(Particles<Dim>& p, std::span<const int> members, double dt,
+                           const double* gradients) const override;
   // Nonlocal damage reads the neighbours' strains.
   bool pointwise() const override { return !parameters_.internal_length; }
   // Damage of one particle, given its history value, effective stress
@@ -131,7 +132,7 @@ class ElasticDamage final : public Material<Dim> {
   double modulus_scale(const Particles<Dim>& p, int i) const;   // s_E
   // The step's kinematics and the elastic trial of the members' undamaged
   // stresses over dt.
-  void trial(Particles<Dim>& p, std::span<const int> members, double dt) const;
+  void trial(Particles<Dim>& p, std::span<const int> members, double dt, const double* gradients) const;
   // Ordered principal stresses, with the strains they hold, and in the
   // plane the decomposition of the effective stress they came from.
   struct Stresses;
