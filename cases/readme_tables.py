@@ -495,6 +495,7 @@ block("mpm benchmark chunk lanes", "mpm_solid/benchmark/compare-chunk-lanes-16-8
 block("mpm benchmark mapped ahead", "mpm_solid/benchmark/compare-63e0ffd-87a87e7-46a287f.csv")(mpm_benchmark_builds)
 block("mpm benchmark gradients in lanes", "mpm_solid/benchmark/compare-63e0ffd-c3795f7-lanes.csv")(mpm_benchmark_builds)
 block("outburst cost mapped ahead", "cases/outburst/benchmark/outburst-benchmark-mapped-ahead.csv")(outburst_cost)
+block("outburst cost gradients in lanes", "cases/outburst/benchmark/outburst-benchmark-lanes.csv")(outburst_cost)
 
 
 @block("mpm benchmark", "mpm_solid/benchmark/mpm-benchmark.csv")

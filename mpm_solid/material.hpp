@@ -84,11 +84,11 @@ class Material {
   // update reads other particles (a nonlocal average) overrides this.
   virtual Dissipation update_stress(Particles<Dim>& p, const std::vector<int>& members, double dt) const;
 
-  // The same for a few particles (at most chunk_size), serially, for a
-  // pointwise() material: the solver calls it from inside its own parallel
-  // pass, between gathering the chunk's velocity gradients and scattering
-  // its forces, while the chunk's fields are still in cache. `gradients`:
-  // where the members' velocity gradients are (ChunkGradients).
+  // The same for a few particles, serially, for a pointwise() material: the
+  // solver calls it from inside its own parallel pass, between gathering the
+  // chunk's velocity gradients and scattering its forces, while the chunk's
+  // fields are still in cache. `gradients`: where the members' velocity
+  // gradients are (at most chunk_size members when given; see chunk_size).
   virtual Dissipation update_chunk(Particles<Dim>& p, std::span<const int> members, double dt,
                                    const double* gradients) const = 0;
   // Whether a particle's update reads only its own fields.
@@ -153,16 +153,16 @@ template <int Dim>
 
 // Particles per chunk of a pass that runs a material's update between
 // other work on the same particles: a chunk's fields and stencils stay in
-// the first cache levels (64 quadratic B-spline stencils, as StencilLanes
-// holds them, take 7 kB in the plane and 11 kB in 3D).
-inline constexpr int chunk_size = 64;
-
+// the first cache levels (quadratic B-spline stencils, as StencilLanes holds
+// them, take 7 kB in the plane and 11 kB in 3D at this size).
+//
 // Where a stress update reads the velocity gradients of a chunk's members:
 // null, each particle's own p.velocity_gradient (the solver's split passes
 // store it); else a chunk's, one SIMD lane per member, entry e = r + Dim c
 // (Eigen's order) of member k at gradients[e * chunk_size + k]. The fused
 // pass keeps them so, out of the particles' arrays, whose stores were a
 // measurable share of its step (README.md, The MPM solver).
+inline constexpr int chunk_size = 64;
 
 // f(std::integral_constant<int, 0>{}), ..., f(std::integral_constant<int, N - 1>{}):
 // a small loop written out at compile time.

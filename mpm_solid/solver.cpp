@@ -737,9 +737,9 @@ void Solver<Dim>::update_and_scatter(double dt) {
       for (int c = 0; c < chunks; ++c) {
         const auto chunk = members.subspan(c * chunk_size, std::min(chunk_size, n - c * chunk_size));
         const int lanes = static_cast<int>(chunk.size());
-        // Consecutive members by position: the lanes load the positions and
-        // store the gradients as blocks; through the list they were gathers
-        // and scatters, the positions' gather the pass's hottest instruction.
+        // Consecutive members by position: the lanes load the positions as
+        // blocks; through the list they were gathers, the positions' gather
+        // the pass's hottest instruction.
         by_position(chunk, [&](auto particle) __attribute__((always_inline)) {
           s.compute(p.x.data(), p.half_width.data(), particle, lanes);
           alignas(64) double l[Dim][Dim][chunk_size];

@@ -4,11 +4,14 @@ ROUNDS times each on one thread, and prints each row's best throughput per
 build and its ratio to the first build's. Single runs on a shared machine
 land in a fast or a slow mode, so the best of the rounds is compared, the
 builds interleaved so that a load on the machine falls on all of them.
-Builds whose mpm-benchmark measures one row at a time (--shape and
---material, from 5e08b15 on) take turns row by row, a second apart: a slow
-spell of the machine then falls on all of them, where whole runs, a minute
-apart, could catch it in one build's run alone. --cpu pins every run to one
-core (on this kind of machine the two cores' speeds differ at times).
+Builds whose mpm-benchmark measures one row alone (it takes --shape and
+--material) take turns row by row, one row's run apart (about a second at
+1e5 particles): a slow spell of the machine then falls on all of them,
+where whole runs, a minute apart, could catch it in one build's run alone.
+Older builds (63e0ffd's, say) run whole once a round, before the others'
+rows; the rows are found by one unbooked run of the first row-wise build.
+--cpu pins every run to one core (on this kind of machine the two cores'
+speeds differ at times). A build named twice shows the run's own noise.
 
 usage: compare-mpm-benchmark.py [--particles N] [--rounds R] [--dimension 2|3] [--cpu C] [--csv FILE] NAME=BUILD_DIR ...
   e.g. compare-mpm-benchmark.py before=/tmp/old/build after=build
