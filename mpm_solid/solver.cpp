@@ -979,9 +979,8 @@ template <class M>
 // Books the moved particles start .. start + lanes - 1: the work of a pore
 // pressure on them (with_pore_work: where the step stored their velocity
 // gradients; the fused pass books it itself), whether they went wrong or
-// left, and the fastest signal
-// among those that moved well (finite, on the grid and below their runaway
-// speed), which sets the next step. Over SIMD lanes, the work then summed
+// left, and the fastest signal among those that moved well (finite, on the
+// grid and below their runaway speed), which sets the next step. Over SIMD lanes, the work then summed
 // particle by particle, in order; the other books are counts and a maximum,
 // which no order changes.
 template <int Dim>

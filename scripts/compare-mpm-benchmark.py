@@ -79,15 +79,16 @@ def main():
         for row, value in rows.items():
             best[name][row] = max(best[name].get(row, 0.0), value)
 
-    rows = []
+    measured = []  # the (shape, material) rows the row-wise builds run
     for r in range(args.rounds):
         for name, folder in whole:
             book(name, run(folder, args.particles, args.dimension, args.cpu))
         if rowwise:
             # The rows the first such build measures by default (found once,
             # not booked), each then by every such build in turn.
-            rows = rows or list(run(rowwise[0][1], args.particles, args.dimension, args.cpu, threads=["--threads", "1"]))
-            for row in rows:
+            measured = measured or list(
+                run(rowwise[0][1], args.particles, args.dimension, args.cpu, threads=["--threads", "1"]))
+            for row in measured:
                 for name, folder in rowwise:
                     book(name, run(folder, args.particles, args.dimension, args.cpu, row))
         print(f"round {r + 1} of {args.rounds} done", file=sys.stderr)
