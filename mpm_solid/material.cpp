@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include "common/registry.hpp"
 
@@ -13,6 +14,9 @@ double Elasticity::p_wave_speed() const {
 
 template <int Dim>
 Dissipation Material<Dim>::update_stress(Particles<Dim>& p, const std::vector<int>& members, double dt) const {
+  if (!members.empty() && p.velocity_gradient.size() != p.size())
+    throw std::logic_error("Material::update_stress: the particles store no velocity gradients "
+                           "(Particles::need_velocity_gradients)");
   return over_chunks(members, [&](std::span<const int> part) { return update_chunk(p, part, dt, nullptr); });
 }
 

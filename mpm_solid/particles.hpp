@@ -26,18 +26,18 @@ struct Particles {
   std::vector<double> half_width;           // initial half-width in cells (GIMP)
   std::vector<Mat<Dim>> stress;             // Cauchy, tension positive [Pa]
   std::vector<double> stress_zz;            // out-of-plane stress (plane strain; 3D: absent)
-  // L = grad v [1/s] of the last step that stored it: the split passes
-  // (MUSL, USL, smoothed dilatation, nonlocal damage). USF's fused pass keeps
-  // each chunk's in SIMD lanes instead (chunk_size, material.hpp).
-  std::vector<Mat<Dim>> velocity_gradient;
   std::vector<Mat<Dim>> deformation;        // F
-  std::vector<Mat<Dim>> affine;             // APIC's B matrix
   std::vector<std::int32_t> material;       // index into the scene's materials
   std::vector<std::int32_t> id;             // stable identity (tracers, output)
 
   // Fields only some scenes need: empty unless created (by need_*, at their
-  // initial values) for a material, a load or another program that uses them;
-  // a scene that names none of those carries none of them.
+  // initial values) for a material, a load, a transfer or another program
+  // that uses them; a scene that names none of those carries none of them.
+  // L = grad v [1/s] of the last step, for the steps that store it: the split
+  // passes (MUSL, USL, smoothed dilatation, nonlocal damage). USF's fused pass
+  // keeps each chunk's in SIMD lanes instead (chunk_size, material.hpp).
+  std::vector<Mat<Dim>> velocity_gradient;
+  std::vector<Mat<Dim>> affine;             // APIC's B matrix
   std::vector<Vec<Dim>> external_force;     // set by another program [N; N per m in 2D]
   std::vector<Vec<Dim>> surface_force;      // boundary tractions of the scene [N; N per m in 2D]
   // Isotropic pressure another program adds to the total stress (alpha p of a
@@ -89,10 +89,11 @@ struct Particles {
         Field<double>{"volume0", &P::volume0}, Field<double>{"half_width", &P::half_width},
         Field<Mat<Dim>>{"stress", &P::stress},
         Field<double>{.name = "stress_zz", .values = &P::stress_zz, .plane_only = true},
-        Field<Mat<Dim>>{"velocity_gradient", &P::velocity_gradient},
-        Field<Mat<Dim>>{"deformation", &P::deformation}, Field<Mat<Dim>>{"affine", &P::affine},
+        Field<Mat<Dim>>{"deformation", &P::deformation},
         Field<std::int32_t>{.name = "material", .values = &P::material, .written = Written::always},
         Field<std::int32_t>{.name = "id", .values = &P::id, .written = Written::always},
+        Field<Mat<Dim>>{"velocity_gradient", &P::velocity_gradient, "stored velocity gradients"},
+        Field<Mat<Dim>>{"affine", &P::affine, "apic"},
         Field<Vec<Dim>>{"external_force", &P::external_force, "loads"},
         Field<Vec<Dim>>{"surface_force", &P::surface_force, "loads"},
         Field<double>{"pore_pressure", &P::pore_pressure, "pore pressure"},
@@ -136,6 +137,8 @@ struct Particles {
   void need_pore_pressure() { need("pore pressure"); }
   void need_plastic_strain() { need("plasticity"); }
   void need_damage() { need("damage"); }
+  void need_velocity_gradients() { need("stored velocity gradients"); }
+  void need_affine() { need("apic"); }
 
   std::size_t size() const { return x.size(); }
 
@@ -187,9 +190,7 @@ struct Particles {
     half_width.push_back(half_width_cells);
     stress.push_back(initial_stress);
     if constexpr (Dim == 2) stress_zz.push_back(initial_stress_zz);
-    velocity_gradient.push_back(Mat<Dim>::Zero());
     deformation.push_back(Mat<Dim>::Identity());
-    affine.push_back(Mat<Dim>::Zero());
     material.push_back(material_index);
     id.push_back(static_cast<std::int32_t>(id.size()));
     // Optional fields present already grow with the particles.

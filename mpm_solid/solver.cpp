@@ -374,6 +374,7 @@ Solver<Dim>::Solver(Grid<Dim> grid, std::vector<std::unique_ptr<Material<Dim>>> 
   p_modulus_ = p_moduli(materials_);
   pointwise_ = !settings_.smooth_dilatation &&
                std::all_of(materials_.begin(), materials_.end(), [](const auto& m) { return m->pointwise(); });
+  create_transfer_fields();
 
   // One kernel per (shape, scheme), chosen here once.
   const auto with_transfer = [&]<class Shape, Scheme S>() -> void (Solver::*)(double) {
@@ -393,6 +394,14 @@ Solver<Dim>::Solver(Grid<Dim> grid, std::vector<std::unique_ptr<Material<Dim>>> 
     case ShapeKind::gimp: kernel_ = pick.template operator()<Gimp>(); break;
     case ShapeKind::bspline: kernel_ = pick.template operator()<Bspline>(); break;
   }
+}
+
+// The fields only some transfers use: the velocity gradients the split
+// passes store (USF's fused pass keeps them in lanes) and APIC's B.
+template <int Dim>
+void Solver<Dim>::create_transfer_fields() {
+  if (settings_.scheme != Scheme::usf || !pointwise_) particles_.need_velocity_gradients();
+  if (settings_.apic) particles_.need_affine();
 }
 
 template <int Dim>
@@ -994,7 +1003,8 @@ template <int Dim>
   double fastest = census.fastest;
   // Locals, as Speeds holds its fields.
   const double *x = p.x.data()->data(), *v = p.v.data()->data(), *stress = p.stress.data()->data(),
-               *gradient = p.velocity_gradient.data()->data(), *pore_pressure = p.pore_pressure.data(),
+               *gradient = p.velocity_gradient.empty() ? nullptr : p.velocity_gradient.data()->data(),
+               *pore_pressure = p.pore_pressure.data(),
                *volume = p.volume.data();
   const Speeds speeds(p_modulus_, wave_speed_squared_.data(), p);
   const Vec<Dim> lower = grid_.lower, upper = grid_.upper;
@@ -1458,6 +1468,7 @@ void Solver<Dim>::load(const checkpoint::In& in) {
     if (m < 0 || static_cast<std::size_t>(m) >= materials_.size())
       group.fail("material", fmt::format("material {} of a scene with {}", m, materials_.size()));
   particles_ = std::move(p);
+  create_transfer_fields();
   discard_mapping();
   rebuild_material_groups();
   fastest_ = 0;

@@ -344,6 +344,7 @@ class Solver {
   void grid_update(double dt);
   double apply_walls(std::vector<Vec<Dim>>& velocity) const;
   void apply_platens(std::vector<Vec<Dim>>& velocity, double impulse, double dt);
+  void create_transfer_fields();
   void find_obstacle_nodes();
   void remove_supports();  // the settling stage is over
   // Folds what the particles gave the ghost nodes beyond fixed and roller

@@ -28,6 +28,7 @@ Particles<2> one_particle() {
   p.add(Vec<2>::Zero(), Vec<2>::Zero(), 1, 1, 0.25, Mat<2>::Zero(), 0, 0);
   p.need_plastic_strain();  // what the damage and plasticity models keep
   p.need_damage();
+  p.need_velocity_gradients();  // as a solver's split passes store them
   return p;
 }
 
@@ -313,6 +314,7 @@ TEST_CASE("elastic-damage: a chunk settled over SIMD lanes ends as each of its p
     std::vector<int> members(n);
     std::iota(members.begin(), members.end(), 0);
     m.create_fields(together, members);
+    together.need_velocity_gradients();
     std::vector<Mat<2>> l(n);
     for (int k = 0; k < n; ++k) {
       // Eight amplitudes: strains from 2e-5 to 3.5e-4 along each direction.

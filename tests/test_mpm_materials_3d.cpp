@@ -44,6 +44,7 @@ Particles<3> one_particle(const Mat<3>& stress = Mat<3>::Zero()) {
   p.add(Vec<3>::Zero(), Vec<3>::Zero(), 1, 1, 0.25, stress, 0, 0);
   p.need_plastic_strain();
   p.need_damage();
+  p.need_velocity_gradients();
   return p;
 }
 

@@ -30,6 +30,7 @@ Particles<Dim> random_particles(int n, std::mt19937& rng) {
     for (int e = 0; e < Dim * Dim; ++e) stress.data()[e] = 1e6 * u(rng);
     stress = (0.5 * (stress + stress.transpose())).eval();
     p.add(Vec<Dim>::Zero(), Vec<Dim>::Zero(), 1, 1 + 0.1 * u(rng), 0.25, stress, 1e6 * u(rng), 0);
+    p.need_velocity_gradients();
     for (int e = 0; e < Dim * Dim; ++e) {
       // Strain rates over six decades, and deformation near the identity.
       p.velocity_gradient[i].data()[e] = u(rng) * std::pow(10.0, 3 * u(rng));
