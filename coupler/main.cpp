@@ -7,6 +7,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "common/atomic_file.hpp"
 #include "common/limits.hpp"
 #include "common/output_folder.hpp"
 #include "common/program.hpp"
@@ -75,9 +76,12 @@ void check_run_length(scene::Table root, const coupling::CoupledSetup<Dim>& setu
 // participants' saving and restoring, logs.
 template <int Dim>
 struct RunTimes {
+  mpm::StepTimes phases;
   double mpm, gas_force, solid = 0, seepage = 0, coupler = 0;
   explicit RunTimes(const coupling::CoupledModel<Dim>& model)
-      : mpm(model.solid().step_times().total()), gas_force(model.solid_side().gas_force_seconds()) {
+      : phases(model.solid().step_times()),
+        mpm(phases.total()),
+        gas_force(model.solid_side().gas_force_seconds()) {
     for (const auto& r : model.coupling().records()) {
       solid += r.second_seconds;
       seepage += r.first_seconds;
@@ -94,6 +98,25 @@ struct RunTimes {
                        "of {:.3g} s",
                        share(steps), share(gas), share(solid_all - steps - gas), share(seepage - start.seepage),
                        share(coupler - start.coupler), share(rest), wall);
+  }
+  // The same parts as a CSV (part, seconds), the MPM steps by phase among
+  // them: what scripts/outburst-benchmark.py reads to show what limits a run.
+  std::string table(const RunTimes& start, double wall) const {
+    const double solid_all = solid - start.solid, seep = seepage - start.seepage, coupling = coupler - start.coupler;
+    const double steps = mpm - start.mpm, gas = gas_force - start.gas_force;
+    std::string out = "part,seconds\n";
+    const auto row = [&out](const char* part, double seconds) { out += fmt::format("{},{:.6g}\n", part, seconds); };
+    row("mpm_particles_to_grid", phases.map - start.phases.map);
+    row("mpm_grid", phases.grid - start.phases.grid);
+    row("mpm_stresses_and_forces", phases.stress - start.phases.stress);
+    row("mpm_grid_to_particles", phases.motion - start.phases.motion);
+    row("gas_force", gas);
+    row("solid_bookkeeping", solid_all - steps - gas);
+    row("seepage", seep);
+    row("exchanges_and_acceleration", coupling);
+    row("output_and_rest", wall - solid_all - seep - coupling);
+    row("wall", wall);
+    return out;
   }
 };
 
@@ -207,7 +230,9 @@ int run_in(const RunOptions& options, scene::Document& doc) {
                  loop.peak_kinetic_energy());
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   spdlog::info("MPM steps' wall time: {}", mpm::describe(solid.step_times()));
-  spdlog::info("the run's wall time: {}", RunTimes(model).since(times_from, wall));
+  const RunTimes times_to(model);
+  spdlog::info("the run's wall time: {}", times_to.since(times_from, wall));
+  output::write_file_atomically(directory / "wall_times.csv", times_to.table(times_from, wall));
   spdlog::info("done: {} windows, {} sub-iterations, {} MPM steps, {:.3g} s wall; gas released {:.4g} {}, "
                "{} particles left the grid",
                coupler.records().size(), driver.iterations, solid.steps(), wall, seepage_solver.balance().total_outflow(),

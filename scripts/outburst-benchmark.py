@@ -4,7 +4,8 @@ second and its run to rest (cases/outburst/run-to-rest.sh's scene), each
 build in turn, with the wall time, the solid's share of it and its MPM
 throughput (particle-steps per second of solid time, from coupling.csv and
 mpm_history.csv), beside mpm-benchmark's standalone throughput at the same
-particle count, shape and material (B-splines, elastic_damage) and threads.
+particle count, shape and material (B-splines, elastic_damage) and threads,
+and the parts of the wall time by the program's own clocks (wall_times.csv).
 
 usage: scripts/outburst-benchmark.py [--threads 2] [--only first_second|to_rest] [--set KEY=VALUE ...] [--csv FILE] [--out DIR] NAME=BUILD_DIR ...
   e.g. scripts/outburst-benchmark.py --csv results/outburst-benchmark.csv before=/tmp/old/build after=build
@@ -34,6 +35,10 @@ TO_REST = ['scene.end_time="10 s"', 'output.interval="0.1 s"', 'seepage.mesh.fil
            'mpm.grid.origin=["-75 m", "0 m"]', 'mpm.grid.size=["120 m", "9 m"]',
            'mpm.obstacles[0].box_min=["-75 m", "0 m"]', 'mpm.obstacles[1].box_min=["-75 m", "6 m"]']
 CASES = {"first_second": [], "to_rest": TO_REST}
+# The parts of a run's wall time the outburst program writes to wall_times.csv (builds from this one on; older
+# ones leave these columns empty).
+PARTS = ["mpm_particles_to_grid", "mpm_grid", "mpm_stresses_and_forces", "mpm_grid_to_particles", "gas_force",
+         "solid_bookkeeping", "seepage", "exchanges_and_acceleration", "output_and_rest"]
 ROW = re.compile(r"^\s*(\d+)\s+bspline\s+elastic_damage\s+([0-9.e+]+)")
 
 
@@ -70,9 +75,14 @@ def run(build, case, threads, folder, overrides):
     steps = particle_steps(folder)
     with open(os.path.join(folder, "mpm_history.csv")) as f:
         mpm_steps = int(list(csv.DictReader(f))[-1]["step"])
+    parts = {}
+    if os.path.exists(os.path.join(folder, "wall_times.csv")):
+        with open(os.path.join(folder, "wall_times.csv")) as f:
+            parts = {r["part"]: r["seconds"] for r in csv.DictReader(f)}
     return {"overrides": "; ".join(overrides), "wall_s": wall, "solid_s": solid,
             "simulated_s": float(windows[-1]["time"]), "particles": int(windows[0]["particles"]),
-            "mpm_steps": mpm_steps, "coupled_particle_steps_per_s": steps / solid}
+            "mpm_steps": mpm_steps, "coupled_particle_steps_per_s": steps / solid} | {
+        f"{p}_s": parts.get(p, "") for p in PARTS}
 
 
 def main():
