@@ -498,6 +498,35 @@ block("outburst cost mapped ahead", "cases/outburst/benchmark/outburst-benchmark
 block("outburst cost gradients in lanes", "cases/outburst/benchmark/outburst-benchmark-lanes.csv")(outburst_cost)
 
 
+# The parts of a coupled run's wall_times.csv (coupler/main.cpp), as scripts/outburst-benchmark.py names its columns.
+WALL_PARTS = ["mpm_particles_to_grid", "mpm_grid", "mpm_stresses_and_forces", "mpm_grid_to_particles", "gas_force",
+              "solid_bookkeeping", "seepage", "exchanges_and_acceleration", "output_and_rest"]
+
+
+@block("outburst to rest limits", "cases/outburst/benchmark/outburst-benchmark-limits.csv")
+def outburst_limits(rows):
+    """Where the run to rest's wall time goes (the program's wall_times.csv, through scripts/outburst-benchmark.py),
+    per MPM step, and what the run would take with its MPM steps at mpm-benchmark's standalone throughput for the
+    same particles, shape, material and threads, the rest as measured."""
+    lines = ["| build | MPM steps | wall [s] | MPM: grid / stresses and forces / grid to particles [µs a step] | "
+             "all else: gas force, seepage, output and the rest [µs a step] | MPM at the standalone rate [µs a step] | "
+             "wall with it [s] |", "|---|---|---|---|---|---|---|"]
+    for r in rows:
+        if r["case"] != "to_rest" or not r.get("mpm_grid_s"):
+            continue
+        steps, wall = int(r["mpm_steps"]), float(r["wall_s"])
+        per_step = {part: 1e6 * float(r[f"{part}_s"]) / steps for part in WALL_PARTS}
+        mpm = sum(v for k, v in per_step.items() if k.startswith("mpm_"))
+        rest = sum(v for k, v in per_step.items() if not k.startswith("mpm_"))
+        standalone = 1e6 * int(r["particles"]) / float(r["standalone_particle_steps_per_s"])
+        lines.append(f"| {r['build']} | {steps:,} | {wall:.1f} | {mpm:.0f}: {per_step['mpm_grid']:.0f} / "
+                     f"{per_step['mpm_stresses_and_forces']:.0f} / {per_step['mpm_grid_to_particles']:.0f} | "
+                     f"{rest:.0f}: {per_step['gas_force']:.0f}, {per_step['seepage']:.0f}, "
+                     f"{per_step['output_and_rest']:.0f} | {standalone:.0f} | "
+                     f"{1e-6 * steps * (standalone + rest):.1f} |")
+    return lines
+
+
 @block("mpm benchmark", "mpm_solid/benchmark/mpm-benchmark.csv")
 def mpm_benchmark(rows):
     materials = ["elastic", "drucker_prager", "elastic_damage"]
