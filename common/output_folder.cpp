@@ -25,7 +25,8 @@ namespace {
 bool written_by_a_run(const std::string& name) {
   const auto ends_with = [&](std::string_view end) { return name.ends_with(end); };
   return ends_with(".xdmf") || ends_with(".h5") || name.find(".partial-") != std::string::npos ||
-         name == "seepage_history.csv" || name == "mpm_history.csv" || name == "tracers.csv" || name == "coupling.csv";
+         name == "seepage_history.csv" || name == "mpm_history.csv" || name == "tracers.csv" || name == "coupling.csv" ||
+         name == "wall_times.csv";
 }
 
 // The run a lock file names ("outburst, pid 1234, started ..."), or empty.

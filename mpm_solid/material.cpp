@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
 
 #include "common/registry.hpp"
 
@@ -14,9 +13,7 @@ double Elasticity::p_wave_speed() const {
 
 template <int Dim>
 Dissipation Material<Dim>::update_stress(Particles<Dim>& p, const std::vector<int>& members, double dt) const {
-  if (!members.empty() && p.velocity_gradient.size() != p.size())
-    throw std::logic_error("Material::update_stress: the particles store no velocity gradients "
-                           "(Particles::need_velocity_gradients)");
+  require_velocity_gradients(p, members);
   return over_chunks(members, [&](std::span<const int> part) { return update_chunk(p, part, dt, nullptr); });
 }
 

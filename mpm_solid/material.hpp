@@ -15,6 +15,7 @@
 #include <memory>
 #include <optional>
 #include <span>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <type_traits>
@@ -163,6 +164,16 @@ template <int Dim>
 // pass keeps them so, out of the particles' arrays, whose stores were a
 // measurable share of its step (README.md, The MPM solver).
 inline constexpr int chunk_size = 64;
+
+// A split pass's stress update reads p.velocity_gradient, which only runs
+// whose transfer stores it carry (Particles::need_velocity_gradients): a
+// clear error before the parallel loop, rather than a read of an empty field.
+template <int Dim>
+void require_velocity_gradients(const Particles<Dim>& p, const std::vector<int>& members) {
+  if (!members.empty() && p.velocity_gradient.size() != p.size())
+    throw std::logic_error("a material's update_stress: the particles store no velocity gradients "
+                           "(Particles::need_velocity_gradients)");
+}
 
 // f(std::integral_constant<int, 0>{}), ..., f(std::integral_constant<int, N - 1>{}):
 // a small loop written out at compile time.

@@ -33,6 +33,7 @@ struct Particles {
   // Fields only some scenes need: empty unless created (by need_*, at their
   // initial values) for a material, a load, a transfer or another program
   // that uses them; a scene that names none of those carries none of them.
+
   // L = grad v [1/s] of the last step, for the steps that store it: the split
   // passes (MUSL, USL, smoothed dilatation, nonlocal damage). USF's fused pass
   // keeps each chunk's in SIMD lanes instead (chunk_size, material.hpp).
@@ -123,7 +124,9 @@ struct Particles {
   }
 
   // Creates the optional fields of an effect, at their initial values, if
-  // they are not there yet.
+  // they are not there yet. Among no particles a created field is as empty
+  // as an absent one, and add() does not grow it: create fields once the
+  // particles are there.
   void need(const char* effect) {
     for_each_field([&](const auto& field, auto& values) {
       if (!field.optional() || std::string_view(field.effect) != effect || values.size() == size()) return;

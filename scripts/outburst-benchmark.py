@@ -36,7 +36,8 @@ TO_REST = ['scene.end_time="10 s"', 'output.interval="0.1 s"', 'seepage.mesh.fil
            'mpm.obstacles[0].box_min=["-75 m", "0 m"]', 'mpm.obstacles[1].box_min=["-75 m", "6 m"]']
 CASES = {"first_second": [], "to_rest": TO_REST}
 # The parts of a run's wall time the outburst program writes to wall_times.csv (builds from this one on; older
-# ones leave these columns empty).
+# ones leave these columns empty), which add up to its run loop's wall time (run_loop_wall_s: the process's
+# wall_s less its start, settling and end).
 PARTS = ["mpm_particles_to_grid", "mpm_grid", "mpm_stresses_and_forces", "mpm_grid_to_particles", "gas_force",
          "solid_bookkeeping", "seepage", "exchanges_and_acceleration", "output_and_rest"]
 ROW = re.compile(r"^\s*(\d+)\s+bspline\s+elastic_damage\s+([0-9.e+]+)")
@@ -66,6 +67,9 @@ def run(build, case, threads, folder, overrides):
                "-j", str(threads)]
     for o in CASES[case] + overrides:
         command += ["--set", o]
+    times = os.path.join(folder, "wall_times.csv")
+    if os.path.exists(times):
+        os.remove(times)  # an older build's run, which writes none, is not to read a newer one's
     start = time.monotonic()
     subprocess.run(command, check=True, capture_output=True)
     wall = time.monotonic() - start
@@ -76,13 +80,13 @@ def run(build, case, threads, folder, overrides):
     with open(os.path.join(folder, "mpm_history.csv")) as f:
         mpm_steps = int(list(csv.DictReader(f))[-1]["step"])
     parts = {}
-    if os.path.exists(os.path.join(folder, "wall_times.csv")):
-        with open(os.path.join(folder, "wall_times.csv")) as f:
+    if os.path.exists(times):
+        with open(times) as f:
             parts = {r["part"]: r["seconds"] for r in csv.DictReader(f)}
     return {"overrides": "; ".join(overrides), "wall_s": wall, "solid_s": solid,
             "simulated_s": float(windows[-1]["time"]), "particles": int(windows[0]["particles"]),
-            "mpm_steps": mpm_steps, "coupled_particle_steps_per_s": steps / solid} | {
-        f"{p}_s": parts.get(p, "") for p in PARTS}
+            "mpm_steps": mpm_steps, "coupled_particle_steps_per_s": steps / solid,
+            "run_loop_wall_s": parts.get("wall", "")} | {f"{p}_s": parts.get(p, "") for p in PARTS}
 
 
 def main():

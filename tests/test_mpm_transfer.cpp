@@ -29,8 +29,8 @@ double spin_kept(ShapeKind shape, bool apic, double flip, int steps) {
     p.add(x, omega * Vec<2>(-r.y(), r.x()), 1000 * volume, volume, 0.25, Mat<2>::Zero(), 0, 0);
     if (apic) {
       p.need_affine();
-      p.affine.back() << 0, -omega, omega, 0;
-    }  // the rigid rotation's velocity gradient
+      p.affine.back() << 0, -omega, omega, 0;  // the rigid rotation's velocity gradient
+    }
   }
   Settings<2> s;
   s.shape = shape;

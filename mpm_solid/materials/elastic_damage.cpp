@@ -519,6 +519,7 @@ Dissipation ElasticDamage<Dim>::settle_plane(Particles<Dim>& p, std::span<const 
 template <int Dim>
 Dissipation ElasticDamage<Dim>::update_stress(Particles<Dim>& p, const std::vector<int>& members, double dt) const {
   if (pointwise()) return Material<Dim>::update_stress(p, members, dt);
+  require_velocity_gradients(p, members);
   // Nonlocal: every member's trial stress and driving strain first, then
   // their averages over the internal length, then the damage.
   over_chunks(members, [&](std::span<const int> part) {
