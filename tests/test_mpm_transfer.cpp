@@ -64,3 +64,32 @@ TEST_CASE("APIC conserves angular momentum where PIC dissipates it", "[mpm][tran
     CHECK(pic < 0.5);
   }
 }
+
+// A transfer's own fields exist only in runs whose transfer uses them: USF's
+// fused FLIP pass keeps the velocity gradients in SIMD lanes and needs no B.
+TEST_CASE("the velocity gradients and APIC's B are particle fields only where the transfer uses them",
+          "[mpm][transfer][particles]") {
+  struct Run {
+    Scheme scheme;
+    bool apic, smooth, gradients, affine;
+  };
+  for (const Run r : {Run{Scheme::usf, false, false, false, false}, Run{Scheme::usf, true, false, false, true},
+                      Run{Scheme::usf, false, true, true, false}, Run{Scheme::usl, false, false, true, false},
+                      Run{Scheme::musl, true, false, true, true}}) {
+    const Grid<2> g = grid(1.0, 1.0, 0.1);
+    Settings<2> s;
+    s.scheme = r.scheme;
+    s.apic = r.apic;
+    s.smooth_dilatation = r.smooth;
+    s.gravity = Vec<2>(0, -9.81);
+    Solver<2> solver(g, elastic({1000, 1e6, 0.3}), block(g, Vec<2>(0.2, 0.2), Vec<2>(0.6, 0.5), 1000, 2), s);
+    INFO("scheme " << int(r.scheme) << ", APIC " << r.apic << ", smoothed dilatation " << r.smooth);
+    const auto& p = solver.particles();
+    CHECK(p.velocity_gradient.size() == (r.gradients ? p.size() : 0));
+    CHECK(p.affine.size() == (r.affine ? p.size() : 0));
+    for (int k = 0; k < 20; ++k) solver.step(solver.stable_time_step());
+    CHECK(p.velocity_gradient.size() == (r.gradients ? p.size() : 0));
+    // The block has fallen: a stored gradient is the last step's, not zero.
+    if (r.gradients) CHECK(p.velocity_gradient[0].norm() > 0);
+  }
+}
