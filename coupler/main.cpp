@@ -77,46 +77,53 @@ void check_run_length(scene::Table root, const coupling::CoupledSetup<Dim>& setu
 template <int Dim>
 struct RunTimes {
   mpm::StepTimes phases;
-  double mpm, gas_force, solid = 0, seepage = 0, coupler = 0;
+  double gas_force, solid = 0, seepage = 0, coupler = 0;
   explicit RunTimes(const coupling::CoupledModel<Dim>& model)
-      : phases(model.solid().step_times()),
-        mpm(phases.total()),
-        gas_force(model.solid_side().gas_force_seconds()) {
+      : phases(model.solid().step_times()), gas_force(model.solid_side().gas_force_seconds()) {
     for (const auto& r : model.coupling().records()) {
       solid += r.second_seconds;
       seepage += r.first_seconds;
       coupler += r.coupler_seconds;
     }
   }
-  // "MPM steps 76 %, ... of 20.9 s": what was spent after `start`, of `wall` seconds.
-  std::string since(const RunTimes& start, double wall) const {
-    const double steps = mpm - start.mpm, gas = gas_force - start.gas_force, solid_all = solid - start.solid;
-    const double rest = wall - solid_all - (seepage - start.seepage) - (coupler - start.coupler);
-    const auto share = [wall](double part) { return wall > 0 ? 100 * part / wall : 0.0; };
-    return fmt::format("MPM steps {:.0f} %, gas force at the particles {:.0f} %, the solid's step bookkeeping "
-                       "{:.0f} %, seepage {:.0f} %, exchanges and acceleration {:.0f} %, output and the rest {:.0f} % "
-                       "of {:.3g} s",
-                       share(steps), share(gas), share(solid_all - steps - gas), share(seepage - start.seepage),
-                       share(coupler - start.coupler), share(rest), wall);
-  }
-  // The same parts as a CSV (part, seconds), the MPM steps by phase among
-  // them: what scripts/outburst-benchmark.py reads to show what limits a run.
-  std::string table(const RunTimes& start, double wall) const {
-    const double solid_all = solid - start.solid, seep = seepage - start.seepage, coupling = coupler - start.coupler;
-    const double steps = mpm - start.mpm, gas = gas_force - start.gas_force;
-    std::string out = "part,seconds\n";
-    const auto row = [&out](const char* part, double seconds) { out += fmt::format("{},{:.6g}\n", part, seconds); };
-    row("mpm_particles_to_grid", phases.map - start.phases.map);
-    row("mpm_grid", phases.grid - start.phases.grid);
-    row("mpm_stresses_and_forces", phases.stress - start.phases.stress);
-    row("mpm_grid_to_particles", phases.motion - start.phases.motion);
-    row("gas_force", gas);
-    row("solid_bookkeeping", solid_all - steps - gas);
-    row("seepage", seep);
-    row("exchanges_and_acceleration", coupling);
-    row("output_and_rest", wall - solid_all - seep - coupling);
-    row("wall", wall);
-    return out;
+  // What was spent after `start`, of `wall` seconds, by part.
+  struct Spent {
+    mpm::StepTimes steps;
+    double gas_force, bookkeeping, seepage, coupler, rest, wall;
+
+    // "MPM steps 76 %, ... of 20.9 s".
+    std::string shares() const {
+      const auto share = [this](double part) { return wall > 0 ? 100 * part / wall : 0.0; };
+      return fmt::format("MPM steps {:.0f} %, gas force at the particles {:.0f} %, the solid's step bookkeeping "
+                         "{:.0f} %, seepage {:.0f} %, exchanges and acceleration {:.0f} %, output and the rest "
+                         "{:.0f} % of {:.3g} s",
+                         share(steps.total()), share(gas_force), share(bookkeeping), share(seepage), share(coupler),
+                         share(rest), wall);
+    }
+    // The same parts as a CSV (part, seconds), the MPM steps by phase: what
+    // scripts/outburst-benchmark.py reads to show what limits a run.
+    std::string table() const {
+      std::string out = "part,seconds\n";
+      const auto row = [&out](const char* part, double seconds) { out += fmt::format("{},{:.6g}\n", part, seconds); };
+      row("mpm_particles_to_grid", steps.map);
+      row("mpm_grid", steps.grid);
+      row("mpm_stresses_and_forces", steps.stress);
+      row("mpm_grid_to_particles", steps.motion);
+      row("gas_force", gas_force);
+      row("solid_bookkeeping", bookkeeping);
+      row("seepage", seepage);
+      row("exchanges_and_acceleration", coupler);
+      row("output_and_rest", rest);
+      row("wall", wall);
+      return out;
+    }
+  };
+  Spent since(const RunTimes& start, double wall) const {
+    const mpm::StepTimes steps{phases.map - start.phases.map, phases.grid - start.phases.grid,
+                               phases.stress - start.phases.stress, phases.motion - start.phases.motion};
+    const double gas = gas_force - start.gas_force, solid_all = solid - start.solid;
+    const double seep = seepage - start.seepage, coupling = coupler - start.coupler;
+    return {steps, gas, solid_all - steps.total() - gas, seep, coupling, wall - solid_all - seep - coupling, wall};
   }
 };
 
@@ -230,9 +237,9 @@ int run_in(const RunOptions& options, scene::Document& doc) {
                  loop.peak_kinetic_energy());
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   spdlog::info("MPM steps' wall time: {}", mpm::describe(solid.step_times()));
-  const RunTimes times_to(model);
-  spdlog::info("the run's wall time: {}", times_to.since(times_from, wall));
-  output::write_file_atomically(directory / "wall_times.csv", times_to.table(times_from, wall));
+  const auto spent = RunTimes(model).since(times_from, wall);
+  spdlog::info("the run's wall time: {}", spent.shares());
+  output::write_file_atomically(directory / "wall_times.csv", spent.table());
   spdlog::info("done: {} windows, {} sub-iterations, {} MPM steps, {:.3g} s wall; gas released {:.4g} {}, "
                "{} particles left the grid",
                coupler.records().size(), driver.iterations, solid.steps(), wall, seepage_solver.balance().total_outflow(),

@@ -986,15 +986,14 @@ template <class M>
 }  // namespace
 
 // Books the moved particles start .. start + lanes - 1: the work of a pore
-// pressure on them (with_pore_work: where the step stored their velocity
-// gradients; the fused pass books it itself), whether they went wrong or
-// left, and the fastest signal among those that moved well (finite, on the
-// grid and below their runaway speed), which sets the next step. Over SIMD lanes, the work then summed
-// particle by particle, in order; the other books are counts and a maximum,
-// which no order changes.
+// pressure on them (where the step stored their velocity gradients: the
+// fused pass, which keeps them in lanes, books it itself), whether they went
+// wrong or left, and the fastest signal among those that moved well (finite,
+// on the grid and below their runaway speed), which sets the next step. Over
+// SIMD lanes, the work then summed particle by particle, in order; the other
+// books are counts and a maximum, which no order changes.
 template <int Dim>
-[[gnu::always_inline]] inline void Solver<Dim>::count(int start, int lanes, double dt, bool with_pore_work,
-                                                      Census& census) const {
+[[gnu::always_inline]] inline void Solver<Dim>::count(int start, int lanes, double dt, Census& census) const {
   const auto& p = particles_;
   constexpr int most = chunk_lanes;
   assert(lanes <= most);
@@ -1004,8 +1003,7 @@ template <int Dim>
   // Locals, as Speeds holds its fields.
   const double *x = p.x.data()->data(), *v = p.v.data()->data(), *stress = p.stress.data()->data(),
                *gradient = p.velocity_gradient.empty() ? nullptr : p.velocity_gradient.data()->data(),
-               *pore_pressure = p.pore_pressure.data(),
-               *volume = p.volume.data();
+               *pore_pressure = p.pore_pressure.data(), *volume = p.volume.data();
   const Speeds speeds(p_modulus_, wave_speed_squared_.data(), p);
   const Vec<Dim> lower = grid_.lower, upper = grid_.upper;
   const auto over_lanes = [&](auto pore, auto drawn) __attribute__((always_inline)) {
@@ -1039,7 +1037,7 @@ template <int Dim>
       if (finite & inside & !fast & (speed > fastest)) fastest = speed;
     }
   };
-  const bool pore = !lean_build && with_pore_work && !p.pore_pressure.empty();
+  const bool pore = !lean_build && !p.pore_pressure.empty() && !p.velocity_gradient.empty();
   with_draws(p, [&](auto drawn) __attribute__((always_inline)) {
     if (pore)
       over_lanes(std::true_type{}, drawn);
@@ -1136,7 +1134,7 @@ void Solver<Dim>::gather_motion(double dt) {
       lost += loss[lane];
       lost += blend[lane];
     }
-    if constexpr (Move) count(start, lanes, dt, !pointwise_, census);  // pointwise: the fused pass ran
+    if constexpr (Move) count(start, lanes, dt, census);
   };
   if constexpr (Apic) {
 #pragma omp parallel reduction(merge : census) reduction(+ : lost, work, gained)
@@ -1319,7 +1317,7 @@ Census Solver<Dim>::move_particles(double dt) {
   for (int c = 0; c < chunks; ++c) {
     const int start = c * width, end = std::min(n, start + width);
     for (int i = start; i < end; ++i) p.x[i] += displacement_[i];
-    count(start, end - start, dt, true, census);
+    count(start, end - start, dt, census);
   }
   return census;
 }

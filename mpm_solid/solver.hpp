@@ -359,7 +359,7 @@ class Solver {
   void over_layer(int axis, int row, F&& f) const;
   void update_stresses(double dt);
   // At most chunk_lanes particles.
-  void count(int start, int lanes, double dt, bool with_pore_work, Census& census) const;
+  void count(int start, int lanes, double dt, Census& census) const;
   Census move_particles(double dt);
   void remove_escaped(const Census& census, StepInfo& info);
   void rebuild_material_groups();

@@ -2,7 +2,7 @@
 """Whether two run folders of the same scene hold the same results, bit for
 bit: every snapshot each XDMF index lists (dataset by dataset), every CSV
 history row by row, and the last checkpoint's whole state; wall-clock seconds
-and the program's version and build (attributes) are left out, so that two
+(columns, and wall_times.csv whole) and the program's version and build (attributes) are left out, so that two
 builds can be compared. For checking that a change moved no result: build both sides with
 -DOUTBURST_NO_FP_CONTRACTION=ON (where GCC places fused multiply-adds moves
 with inlining), run the scene with each on the same thread count, then
@@ -15,11 +15,11 @@ import os
 import sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests"))
-from run_folder import compare_checkpoints, compare_histories, compare_listed  # noqa: E402
+from run_folder import WALL_CLOCK_FILES, compare_checkpoints, compare_histories, compare_listed  # noqa: E402
 
 
 def files(folder, suffix):
-    return sorted(n for n in os.listdir(folder) if n.endswith(suffix))
+    return sorted(n for n in os.listdir(folder) if n.endswith(suffix) and n not in WALL_CLOCK_FILES)
 
 
 def main(argv):

@@ -9,6 +9,7 @@ import h5py
 import numpy as np
 
 WALL_CLOCK = {"seepage_s", "solid_s", "coupler_s"}  # coupling.csv: seconds each part took
+WALL_CLOCK_FILES = {"wall_times.csv"}  # a coupled run's seconds by part, nothing else
 # Checkpoint datasets that hold wall-clock seconds, or the length of a CSV
 # with such columns.
 WALL_CLOCK_STATE = re.compile(r"(first|second|coupler)_seconds$|coupling_log/bytes$")
