@@ -183,6 +183,24 @@ struct StencilLanes {
     for (int d = 0; d < Dim; ++d) in = in && supported(base[d][lane], support, lattice.nodes_along[d]);
     return in;
   }
+  // Whether lanes on one stencil are scattered as a run: summed in
+  // registers and added to each node once, where lane after lane each
+  // node's sum waited on the last lane's store. Only under linear shapes,
+  // whose stencil is the particle's cell, shared by the particles seeded in
+  // it (or sorted into it). A quadratic stencil starts at the nearest node's
+  // lower neighbour, so a cell's particles at 2 a side have four different
+  // ones, and the sums, too many for the registers, only cost time there
+  // (README.md, The MPM solver).
+  static constexpr bool runs = support == 2;
+
+  // The end of the run of lanes from `lane` (inside) on its stencil.
+  int run_end(int lane, int lanes) const {
+    int end = lane + 1;
+    if constexpr (runs)
+      // inside() too: a flat index beyond the grid's rows can alias one within.
+      while (end < lanes && first[end] == first[lane] && inside(end)) ++end;
+    return end;
+  }
   std::array<int, Dim> lowest(int lane) const {
     std::array<int, Dim> b;
     for (int d = 0; d < Dim; ++d) b[d] = base[d][lane];

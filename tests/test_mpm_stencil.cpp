@@ -145,3 +145,40 @@ TEST_CASE("floor_int is std::floor as an int (whole numbers, either side of them
     CHECK_FALSE(supported(floor_int(x), 3, 1000));
   }
 }
+
+namespace {
+// Lanes in a cell, another cell, the first again, and a support far beyond
+// the grid whose flat index aliases the first cell's (a whole row of nodes
+// further along x, a row lower): only the linear stencils scatter runs, and
+// a run takes the lanes that follow on the same stencil inside the grid.
+template <class Shape>
+std::vector<int> run_ends() {
+  Grid<2> g;
+  g.h = 0.3;
+  g.lower = Vec<2>::Zero();
+  g.cells = {7, 6};
+  g.upper = Vec<2>(7 * g.h, 6 * g.h);
+  const Lattice<2> lattice(g);
+  const double row = lattice.nodes_along[0] * g.h;
+  const std::vector<Vec<2>> x{{1.0, 0.7}, {1.1, 0.8}, {0.4, 0.8}, {1.0, 0.8}, {1.1, 0.7},
+                              {1.0 + row, 0.7 - g.h}, {1.05, 0.75}};
+  const std::vector<double> half_width(x.size(), 0.25);
+  StencilLanes<2, Shape, 16> lanes(lattice);
+  const int n = static_cast<int>(x.size());
+  lanes.compute(x.data(), half_width.data(), [](int lane) { return lane; }, n);
+  REQUIRE_FALSE(lanes.inside(5));
+  REQUIRE(lanes.first[5] == lanes.first[0]);
+  std::vector<int> ends;
+  for (int lane = 0; lane < n; lane = ends.back())
+    ends.push_back(lanes.inside(lane) ? lanes.run_end(lane, n) : lane + 1);
+  return ends;
+}
+}  // namespace
+
+TEST_CASE("linear stencils scatter the lanes that follow on one stencil inside the grid as a run; the others a "
+          "lane at a time",
+          "[mpm][stencil]") {
+  CHECK(run_ends<Linear>() == std::vector<int>{2, 3, 5, 6, 7});
+  CHECK(run_ends<Gimp>() == std::vector<int>{1, 2, 3, 4, 5, 6, 7});
+  CHECK(run_ends<Bspline>() == std::vector<int>{1, 2, 3, 4, 5, 6, 7});
+}
