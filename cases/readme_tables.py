@@ -498,6 +498,10 @@ block("mpm benchmark optional transfer fields", "mpm_solid/benchmark/compare-63e
     mpm_benchmark_builds)
 block("mpm benchmark census in the fused pass", "mpm_solid/benchmark/compare-lanes-census-fused.csv")(
     mpm_benchmark_builds)
+block("mpm benchmark stencil runs", "mpm_solid/benchmark/compare-63e0ffd-5349f14-runs.csv")(mpm_benchmark_builds)
+block("mpm benchmark 3d stencil runs", "mpm_solid/benchmark/compare-3d-5349f14-runs.csv")(mpm_benchmark_builds)
+block("mpm benchmark forces over lanes", "mpm_solid/benchmark/compare-5349f14-runs-forces-over-lanes.csv")(
+    mpm_benchmark_builds)
 block("outburst cost mapped ahead", "cases/outburst/benchmark/outburst-benchmark-mapped-ahead.csv")(outburst_cost)
 block("outburst cost gradients in lanes", "cases/outburst/benchmark/outburst-benchmark-lanes.csv")(outburst_cost)
 
