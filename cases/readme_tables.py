@@ -499,6 +499,7 @@ block("mpm benchmark optional transfer fields", "mpm_solid/benchmark/compare-63e
 block("mpm benchmark census in the fused pass", "mpm_solid/benchmark/compare-lanes-census-fused.csv")(
     mpm_benchmark_builds)
 block("mpm benchmark stencil runs", "mpm_solid/benchmark/compare-63e0ffd-5349f14-runs.csv")(mpm_benchmark_builds)
+block("mpm benchmark runs per lane", "mpm_solid/benchmark/compare-5349f14-runs-per-lane.csv")(mpm_benchmark_builds)
 block("mpm benchmark 3d stencil runs", "mpm_solid/benchmark/compare-3d-5349f14-runs.csv")(mpm_benchmark_builds)
 block("mpm benchmark forces over lanes", "mpm_solid/benchmark/compare-5349f14-runs-forces-over-lanes.csv")(
     mpm_benchmark_builds)

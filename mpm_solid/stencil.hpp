@@ -185,15 +185,17 @@ struct StencilLanes {
   }
   // Whether lanes on one stencil are scattered as a run: summed in
   // registers and added to each node once, where lane after lane each
-  // node's sum waited on the last lane's store. Only under linear shapes,
-  // whose stencil is the particle's cell, shared by the particles seeded in
-  // it (or sorted into it). A quadratic stencil starts at the nearest node's
-  // lower neighbour, so a cell's particles at 2 a side have four different
-  // ones, and the sums, too many for the registers, only cost time there
-  // (README.md, The MPM solver).
+  // node's sum waited on the last lane's store. Only under linear shapes
+  // (support 2), whose stencil is the particle's cell, shared by the
+  // particles seeded in it. A quadratic B-spline stencil starts at the
+  // nearest node's lower neighbour, so a cell's particles at 2 a side have
+  // four different ones, and runs done for every shape had slowed B-splines
+  // (README.md, The MPM solver). GIMP's seeds do share a stencil, but its 9
+  // nodes' sums (27 in 3D) have not been measured against the registers.
   static constexpr bool runs = support == 2;
 
-  // The end of the run of lanes from `lane` (inside) on its stencil.
+  // The end of the run of lanes from `lane` on its stencil; every lane
+  // inside the grid, as all are once the mapping has refused the others.
   int run_end(int lane, int lanes) const {
     int end = lane + 1;
     if constexpr (runs)
@@ -201,6 +203,7 @@ struct StencilLanes {
       while (end < lanes && first[end] == first[lane] && inside(end)) ++end;
     return end;
   }
+
   std::array<int, Dim> lowest(int lane) const {
     std::array<int, Dim> b;
     for (int d = 0; d < Dim; ++d) b[d] = base[d][lane];

@@ -175,8 +175,8 @@ std::vector<int> run_ends() {
 }
 }  // namespace
 
-TEST_CASE("linear stencils scatter the lanes that follow on one stencil inside the grid as a run; the others a "
-          "lane at a time",
+TEST_CASE("run_end: under linear stencils a run is the lanes that follow on one stencil inside the grid, under "
+          "the others one lane",
           "[mpm][stencil]") {
   CHECK(run_ends<Linear>() == std::vector<int>{2, 3, 5, 6, 7});
   CHECK(run_ends<Gimp>() == std::vector<int>{1, 2, 3, 4, 5, 6, 7});
