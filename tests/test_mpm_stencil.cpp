@@ -1,7 +1,8 @@
 // A chunk's stencils (StencilLanes, what the particle passes use) against a
 // stencil per particle (Stencil, what APIC and the dilatation remedy use):
 // the same nodes, weights and gradients to the bit, for every shape in 2D
-// and 3D, and the same verdict on a support that leaves the ghost-padded grid.
+// and 3D, and the same verdict on a support that leaves the ghost-padded grid;
+// and the runs of lanes the linear stencils scatter as one.
 #include <catch2/catch.hpp>
 
 #include <algorithm>
