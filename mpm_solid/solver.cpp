@@ -133,9 +133,7 @@ template <int Dim, class Shape, int Width>
 // whose stencils s holds, into m and mv, and marks the blocks they reach;
 // returns how many lie beyond the ghost nodes (not mapped). A run of lanes
 // on one stencil (StencilLanes::runs) is summed in registers, then added;
-// elsewhere each lane adds straight into the nodes (taken as runs of one
-// lane, through an object holding the sums, the quadratic B-spline elastic
-// row of mpm-benchmark measured 3-7 % slower in alternating runs).
+// elsewhere each lane adds straight into the nodes, as before the runs.
 template <int Dim, class Shape, int Width>
 [[gnu::always_inline]] inline long map_lanes(const Particles<Dim>& p, const StencilLanes<Dim, Shape, Width>& s,
                                              int start, int lanes, double* m, Vec<Dim>* mv, std::uint8_t* reached,
