@@ -13,7 +13,7 @@ rows; the rows are found by one unbooked run of the first row-wise build.
 --cpu pins every run to one core (on this kind of machine the two cores'
 speeds differ at times). A build named twice shows the run's own noise.
 
-usage: compare-mpm-benchmark.py [--particles N] [--rounds R] [--dimension 2|3] [--cpu C] [--csv FILE] NAME=BUILD_DIR ...
+usage: compare-mpm-benchmark.py [--particles N] [--rounds R] [--dimension 2|3] [--cpu C] [--shape S] [--material M] [--csv FILE] NAME=BUILD_DIR ...
   e.g. compare-mpm-benchmark.py before=/tmp/old/build after=build
 """
 import argparse
@@ -66,6 +66,10 @@ def main():
     parser.add_argument("--dimension", type=int, choices=(2, 3), default=2,
                         help="3: the 3D kernel (builds from 53491f2 on)")
     parser.add_argument("--cpu", type=int, help="pin every run to this core")
+    parser.add_argument("--shape", action="append",
+                        help="the row-wise builds measure this shape (repeat for more; default: the benchmark's)")
+    parser.add_argument("--material", action="append",
+                        help="the row-wise builds measure this material (repeat for more; default: the benchmark's)")
     parser.add_argument("--csv", help="also write the table here")
     args = parser.parse_args()
     if args.cpu is not None and args.cpu not in os.sched_getaffinity(0):
@@ -87,7 +91,9 @@ def main():
             # The rows the first such build measures by default (found once,
             # not booked), each then by every such build in turn.
             measured = measured or list(
-                run(rowwise[0][1], args.particles, args.dimension, args.cpu, threads=["--threads", "1"]))
+                run(rowwise[0][1], args.particles, args.dimension, args.cpu,
+                    threads=["--threads", "1"] + (["--shape", *args.shape] if args.shape else []) +
+                    (["--material", *args.material] if args.material else [])))
             for row in measured:
                 for name, folder in rowwise:
                     book(name, run(folder, args.particles, args.dimension, args.cpu, row))
@@ -96,7 +102,9 @@ def main():
     header = ["shape", "material"] + [f"{n} [particle-steps/s]" for n, _ in builds] + \
              [f"{n} / {reference}" for n, _ in builds[1:]]
     rows = []
-    for row in best[reference]:
+    # The rows the row-wise builds measured (an older reference, run whole,
+    # may lack some, whose ratios then read nan), else the reference's.
+    for row in measured or best[reference]:
         values = [best[n].get(row, float("nan")) for n, _ in builds]
         rows.append(list(row) + [f"{v:.4g}" for v in values] + [f"{v / values[0]:.3f}" for v in values[1:]])
     pinned = "" if args.cpu is None else f", on core {args.cpu}"
