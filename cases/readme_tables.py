@@ -503,6 +503,10 @@ block("mpm benchmark runs per lane", "mpm_solid/benchmark/compare-5349f14-runs-p
 block("mpm benchmark 3d stencil runs", "mpm_solid/benchmark/compare-3d-5349f14-runs.csv")(mpm_benchmark_builds)
 block("mpm benchmark forces over lanes", "mpm_solid/benchmark/compare-5349f14-runs-forces-over-lanes.csv")(
     mpm_benchmark_builds)
+block("mpm benchmark sorted by stencil", "mpm_solid/benchmark/compare-c772214-sorted.csv")(mpm_benchmark_builds)
+block("mpm benchmark c772214", "mpm_solid/benchmark/compare-63e0ffd-c772214.csv")(mpm_benchmark_builds)
+block("mpm benchmark c772214 elastic", "mpm_solid/benchmark/compare-63e0ffd-c772214-elastic.csv")(
+    mpm_benchmark_builds)
 block("outburst cost mapped ahead", "cases/outburst/benchmark/outburst-benchmark-mapped-ahead.csv")(outburst_cost)
 block("outburst cost gradients in lanes", "cases/outburst/benchmark/outburst-benchmark-lanes.csv")(outburst_cost)
 
