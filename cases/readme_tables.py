@@ -507,6 +507,8 @@ block("mpm benchmark sorted by stencil", "mpm_solid/benchmark/compare-c772214-so
 block("mpm benchmark c772214", "mpm_solid/benchmark/compare-63e0ffd-c772214.csv")(mpm_benchmark_builds)
 block("mpm benchmark c772214 elastic", "mpm_solid/benchmark/compare-63e0ffd-c772214-elastic.csv")(
     mpm_benchmark_builds)
+block("mpm benchmark c772214 rounds", "mpm_solid/benchmark/compare-63e0ffd-c772214-rounds.csv")(
+    mpm_benchmark_builds)
 block("outburst cost mapped ahead", "cases/outburst/benchmark/outburst-benchmark-mapped-ahead.csv")(outburst_cost)
 block("outburst cost gradients in lanes", "cases/outburst/benchmark/outburst-benchmark-lanes.csv")(outburst_cost)
 

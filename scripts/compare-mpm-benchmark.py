@@ -12,6 +12,10 @@ Older builds (63e0ffd's, say) run whole once a round, before the others'
 rows; the rows are found by one unbooked run of the first row-wise build.
 --cpu pins every run to one core (on this kind of machine the two cores'
 speeds differ at times). A build named twice shows the run's own noise.
+Beside the ratio of the bests, each build's ratio to the first taken round
+by round (the two figures of a row a few seconds apart), and its median
+over the rounds: a slow spell that spans a round falls on both figures of
+it, and the median does not rest on one fast round per build.
 
 usage: compare-mpm-benchmark.py [--particles N] [--rounds R] [--dimension 2|3] [--cpu C] [--shape S] [--material M] [--csv FILE] NAME=BUILD_DIR ...
   e.g. compare-mpm-benchmark.py before=/tmp/old/build after=build
@@ -20,6 +24,7 @@ import argparse
 import csv
 import os
 import re
+import statistics
 import subprocess
 import sys
 
@@ -78,10 +83,12 @@ def main():
     rowwise = [(name, folder) for name, folder in builds if by_rows(folder)]
     whole = [(name, folder) for name, folder in builds if (name, folder) not in rowwise]
     best = {name: {} for name, _ in builds}
+    each = {name: {} for name, _ in builds}  # every round's figure, in order
 
     def book(name, rows):
         for row, value in rows.items():
             best[name][row] = max(best[name].get(row, 0.0), value)
+            each[name].setdefault(row, []).append(value)
 
     measured = []  # the (shape, material) rows the row-wise builds run
     for r in range(args.rounds):
@@ -99,14 +106,22 @@ def main():
                     book(name, run(folder, args.particles, args.dimension, args.cpu, row))
         print(f"round {r + 1} of {args.rounds} done", file=sys.stderr)
     reference = builds[0][0]
+
+    def paired(name, row, against):
+        """The median over the rounds of name's figure over against's in the
+        same round: a slow spell that lasts a round falls on both."""
+        ours, theirs = each[name].get(row, []), each[against].get(row, [])
+        return statistics.median(a / b for a, b in zip(ours, theirs)) if ours and theirs else float("nan")
     header = ["shape", "material"] + [f"{n} [particle-steps/s]" for n, _ in builds] + \
-             [f"{n} / {reference}" for n, _ in builds[1:]]
+             [f"{n} / {reference}" for n, _ in builds[1:]] + \
+             [f"{n} / {reference}, median of rounds" for n, _ in builds[1:]]
     rows = []
     # The rows the row-wise builds measured (an older reference, run whole,
     # may lack some, whose ratios then read nan), else the reference's.
     for row in measured or best[reference]:
         values = [best[n].get(row, float("nan")) for n, _ in builds]
-        rows.append(list(row) + [f"{v:.4g}" for v in values] + [f"{v / values[0]:.3f}" for v in values[1:]])
+        rows.append(list(row) + [f"{v:.4g}" for v in values] + [f"{v / values[0]:.3f}" for v in values[1:]] +
+                    [f"{paired(n, row, reference):.3f}" for n, _ in builds[1:]])
     pinned = "" if args.cpu is None else f", on core {args.cpu}"
     print(f"best of {args.rounds} rounds, {args.particles} particles, 1 thread{pinned}, {args.dimension}D")
     print("| " + " | ".join(header) + " |")
