@@ -13,9 +13,12 @@ rows; the rows are found by one unbooked run of the first row-wise build.
 --cpu pins every run to one core (on this kind of machine the two cores'
 speeds differ at times). A build named twice shows the run's own noise.
 Beside the ratio of the bests, each build's ratio to the first taken round
-by round (the two figures of a row a few seconds apart), and its median
-over the rounds: a slow spell that spans a round falls on both figures of
-it, and the median does not rest on one fast round per build.
+by round, and its median over the rounds: it does not rest on one fast
+round per build. Between row-wise builds a row's two figures in a round
+are a few seconds apart, so a slow spell falls on both; a whole-run
+build's figure comes from the round's start, up to a minute before.
+--shape and --material (either repeated for more) choose the rows of the
+row-wise builds; whole-run builds measure their default rows.
 
 usage: compare-mpm-benchmark.py [--particles N] [--rounds R] [--dimension 2|3] [--cpu C] [--shape S] [--material M] [--csv FILE] NAME=BUILD_DIR ...
   e.g. compare-mpm-benchmark.py before=/tmp/old/build after=build
@@ -80,20 +83,25 @@ def main():
     if args.cpu is not None and args.cpu not in os.sched_getaffinity(0):
         sys.exit(f"--cpu {args.cpu}: this process may run on cores {sorted(os.sched_getaffinity(0))} only")
     builds = named_builds(args.builds, os.path.join("mpm_solid", "mpm-benchmark"))
+    names = [name for name, _ in builds]
+    if len(set(names)) < len(names):
+        sys.exit("each NAME once: the figures are kept by name (a build measured twice takes two names)")
     rowwise = [(name, folder) for name, folder in builds if by_rows(folder)]
+    if (args.shape or args.material) and not rowwise:
+        sys.exit("--shape and --material choose the rows of builds whose mpm-benchmark takes them; none here does")
     whole = [(name, folder) for name, folder in builds if (name, folder) not in rowwise]
     best = {name: {} for name, _ in builds}
-    each = {name: {} for name, _ in builds}  # every round's figure, in order
+    each = {name: {} for name, _ in builds}  # each[name][row][round]
 
-    def book(name, rows):
+    def book(name, rows, r):
         for row, value in rows.items():
             best[name][row] = max(best[name].get(row, 0.0), value)
-            each[name].setdefault(row, []).append(value)
+            each[name].setdefault(row, {})[r] = value
 
     measured = []  # the (shape, material) rows the row-wise builds run
     for r in range(args.rounds):
         for name, folder in whole:
-            book(name, run(folder, args.particles, args.dimension, args.cpu))
+            book(name, run(folder, args.particles, args.dimension, args.cpu), r)
         if rowwise:
             # The rows the first such build measures by default (found once,
             # not booked), each then by every such build in turn.
@@ -103,15 +111,16 @@ def main():
                     (["--material", *args.material] if args.material else [])))
             for row in measured:
                 for name, folder in rowwise:
-                    book(name, run(folder, args.particles, args.dimension, args.cpu, row))
+                    book(name, run(folder, args.particles, args.dimension, args.cpu, row), r)
         print(f"round {r + 1} of {args.rounds} done", file=sys.stderr)
     reference = builds[0][0]
 
     def paired(name, row, against):
         """The median over the rounds of name's figure over against's in the
         same round: a slow spell that lasts a round falls on both."""
-        ours, theirs = each[name].get(row, []), each[against].get(row, [])
-        return statistics.median(a / b for a, b in zip(ours, theirs)) if ours and theirs else float("nan")
+        ours, theirs = each[name].get(row, {}), each[against].get(row, {})
+        ratios = [ours[r] / theirs[r] for r in ours if r in theirs]
+        return statistics.median(ratios) if ratios else float("nan")
     header = ["shape", "material"] + [f"{n} [particle-steps/s]" for n, _ in builds] + \
              [f"{n} / {reference}" for n, _ in builds[1:]] + \
              [f"{n} / {reference}, median of rounds" for n, _ in builds[1:]]
