@@ -470,47 +470,50 @@ def outburst_longer_step(shipped, longer):
     return lines
 
 
-block("outburst cost after 3d", "cases/outburst/benchmark/outburst-benchmark-after-3d.csv")(outburst_cost)
-block("outburst cost stencil lanes", "cases/outburst/benchmark/outburst-benchmark-stencil-lanes.csv")(outburst_cost)
-block("mpm benchmark stencil lanes", "mpm_solid/benchmark/compare-63e0ffd-53491f2-b1c4128.csv")(mpm_benchmark_builds)
-block("outburst cost trial lanes", "cases/outburst/benchmark/outburst-benchmark-trial-lanes.csv")(outburst_cost)
-block("mpm benchmark trial lanes", "mpm_solid/benchmark/compare-63e0ffd-78f1b01-a1314c5.csv")(mpm_benchmark_builds)
-block("mpm benchmark 3d trial lanes", "mpm_solid/benchmark/compare-3d-78f1b01-3d1e790.csv")(mpm_benchmark_builds)
-block("mpm benchmark fused linear", "mpm_solid/benchmark/compare-63e0ffd-78f1b01-edf5ae2.csv")(mpm_benchmark_builds)
-block("mpm benchmark motion lanes", "mpm_solid/benchmark/compare-63e0ffd-e79aca1-aa69a3e.csv")(mpm_benchmark_builds)
-block("mpm benchmark 3d motion lanes", "mpm_solid/benchmark/compare-3d-e79aca1-aa69a3e.csv")(mpm_benchmark_builds)
-block("outburst cost motion lanes", "cases/outburst/benchmark/outburst-benchmark-motion-lanes.csv")(outburst_cost)
-block("mpm benchmark census lanes", "mpm_solid/benchmark/compare-63e0ffd-a49a143-e7788a0.csv")(mpm_benchmark_builds)
-block("mpm benchmark 3d census lanes", "mpm_solid/benchmark/compare-3d-a49a143-e7788a0.csv")(mpm_benchmark_builds)
-block("outburst cost census lanes", "cases/outburst/benchmark/outburst-benchmark-census-lanes.csv")(outburst_cost)
-block("mpm benchmark settle lanes", "mpm_solid/benchmark/compare-63e0ffd-de26bb6-290380f-e0a5804.csv")(
-    mpm_benchmark_builds)
-block("outburst cost settle lanes", "cases/outburst/benchmark/outburst-benchmark-settle-lanes.csv")(outburst_cost)
-block("mpm benchmark active walls", "mpm_solid/benchmark/compare-63e0ffd-877286d-98ecb4e.csv")(mpm_benchmark_builds)
-block("outburst cost active walls", "cases/outburst/benchmark/outburst-benchmark-active-walls.csv")(outburst_cost)
-block("outburst cost gas lanes", "cases/outburst/benchmark/outburst-benchmark-gas-lanes.csv")(outburst_cost)
-block("mpm benchmark sliding lanes", "mpm_solid/benchmark/compare-63e0ffd-906bedb-145f429.csv")(mpm_benchmark_builds)
-block("outburst cost serial sliding", "cases/outburst/benchmark/outburst-benchmark-serial-sliding.csv")(outburst_cost)
-block("mpm benchmark chunk lanes", "mpm_solid/benchmark/compare-chunk-lanes-16-8-32.csv")(mpm_benchmark_builds)
-block("mpm benchmark mapped ahead", "mpm_solid/benchmark/compare-63e0ffd-87a87e7-46a287f.csv")(mpm_benchmark_builds)
-block("mpm benchmark gradients in lanes", "mpm_solid/benchmark/compare-63e0ffd-c3795f7-lanes.csv")(mpm_benchmark_builds)
-block("mpm benchmark optional transfer fields", "mpm_solid/benchmark/compare-63e0ffd-lanes-optional.csv")(
-    mpm_benchmark_builds)
-block("mpm benchmark census in the fused pass", "mpm_solid/benchmark/compare-lanes-census-fused.csv")(
-    mpm_benchmark_builds)
-block("mpm benchmark stencil runs", "mpm_solid/benchmark/compare-63e0ffd-5349f14-runs.csv")(mpm_benchmark_builds)
-block("mpm benchmark runs per lane", "mpm_solid/benchmark/compare-5349f14-runs-per-lane.csv")(mpm_benchmark_builds)
-block("mpm benchmark 3d stencil runs", "mpm_solid/benchmark/compare-3d-5349f14-runs.csv")(mpm_benchmark_builds)
-block("mpm benchmark forces over lanes", "mpm_solid/benchmark/compare-5349f14-runs-forces-over-lanes.csv")(
-    mpm_benchmark_builds)
-block("mpm benchmark sorted by stencil", "mpm_solid/benchmark/compare-c772214-sorted.csv")(mpm_benchmark_builds)
-block("mpm benchmark c772214", "mpm_solid/benchmark/compare-63e0ffd-c772214.csv")(mpm_benchmark_builds)
-block("mpm benchmark c772214 elastic", "mpm_solid/benchmark/compare-63e0ffd-c772214-elastic.csv")(
-    mpm_benchmark_builds)
-block("mpm benchmark c772214 rounds", "mpm_solid/benchmark/compare-63e0ffd-c772214-rounds.csv")(
-    mpm_benchmark_builds)
-block("outburst cost mapped ahead", "cases/outburst/benchmark/outburst-benchmark-mapped-ahead.csv")(outburst_cost)
-block("outburst cost gradients in lanes", "cases/outburst/benchmark/outburst-benchmark-lanes.csv")(outburst_cost)
+# scripts/compare-mpm-benchmark.py's runs, build against build: block, CSV.
+for name, written in [
+    ("mpm benchmark stencil lanes", "compare-63e0ffd-53491f2-b1c4128.csv"),
+    ("mpm benchmark trial lanes", "compare-63e0ffd-78f1b01-a1314c5.csv"),
+    ("mpm benchmark 3d trial lanes", "compare-3d-78f1b01-3d1e790.csv"),
+    ("mpm benchmark fused linear", "compare-63e0ffd-78f1b01-edf5ae2.csv"),
+    ("mpm benchmark motion lanes", "compare-63e0ffd-e79aca1-aa69a3e.csv"),
+    ("mpm benchmark 3d motion lanes", "compare-3d-e79aca1-aa69a3e.csv"),
+    ("mpm benchmark census lanes", "compare-63e0ffd-a49a143-e7788a0.csv"),
+    ("mpm benchmark 3d census lanes", "compare-3d-a49a143-e7788a0.csv"),
+    ("mpm benchmark settle lanes", "compare-63e0ffd-de26bb6-290380f-e0a5804.csv"),
+    ("mpm benchmark active walls", "compare-63e0ffd-877286d-98ecb4e.csv"),
+    ("mpm benchmark sliding lanes", "compare-63e0ffd-906bedb-145f429.csv"),
+    ("mpm benchmark chunk lanes", "compare-chunk-lanes-16-8-32.csv"),
+    ("mpm benchmark mapped ahead", "compare-63e0ffd-87a87e7-46a287f.csv"),
+    ("mpm benchmark gradients in lanes", "compare-63e0ffd-c3795f7-lanes.csv"),
+    ("mpm benchmark optional transfer fields", "compare-63e0ffd-lanes-optional.csv"),
+    ("mpm benchmark census in the fused pass", "compare-lanes-census-fused.csv"),
+    ("mpm benchmark stencil runs", "compare-63e0ffd-5349f14-runs.csv"),
+    ("mpm benchmark runs per lane", "compare-5349f14-runs-per-lane.csv"),
+    ("mpm benchmark 3d stencil runs", "compare-3d-5349f14-runs.csv"),
+    ("mpm benchmark forces over lanes", "compare-5349f14-runs-forces-over-lanes.csv"),
+    ("mpm benchmark sorted by stencil", "compare-c772214-sorted.csv"),
+    ("mpm benchmark c772214", "compare-63e0ffd-c772214.csv"),
+    ("mpm benchmark c772214 elastic", "compare-63e0ffd-c772214-elastic.csv"),
+    ("mpm benchmark c772214 rounds", "compare-63e0ffd-c772214-rounds.csv"),
+]:
+    block(name, "mpm_solid/benchmark/" + written)(mpm_benchmark_builds)
+
+# scripts/outburst-benchmark.py's runs, build against build: block, CSV.
+for name, written in [
+    ("outburst cost after 3d", "outburst-benchmark-after-3d.csv"),
+    ("outburst cost stencil lanes", "outburst-benchmark-stencil-lanes.csv"),
+    ("outburst cost trial lanes", "outburst-benchmark-trial-lanes.csv"),
+    ("outburst cost motion lanes", "outburst-benchmark-motion-lanes.csv"),
+    ("outburst cost census lanes", "outburst-benchmark-census-lanes.csv"),
+    ("outburst cost settle lanes", "outburst-benchmark-settle-lanes.csv"),
+    ("outburst cost active walls", "outburst-benchmark-active-walls.csv"),
+    ("outburst cost gas lanes", "outburst-benchmark-gas-lanes.csv"),
+    ("outburst cost serial sliding", "outburst-benchmark-serial-sliding.csv"),
+    ("outburst cost mapped ahead", "outburst-benchmark-mapped-ahead.csv"),
+    ("outburst cost gradients in lanes", "outburst-benchmark-lanes.csv"),
+]:
+    block(name, "cases/outburst/benchmark/" + written)(outburst_cost)
 
 
 @block("outburst to rest limits", "cases/outburst/benchmark/outburst-benchmark-limits.csv")
