@@ -11,7 +11,8 @@ where whole runs, a minute apart, could catch it in one build's run alone.
 Older builds (63e0ffd's, say) run whole once a round, before the others'
 rows; the rows are found by one unbooked run of the first row-wise build.
 --cpu pins every run to one core (on this kind of machine the two cores'
-speeds differ at times). A build named twice shows the run's own noise.
+speeds differ at times). A build given twice, under two names, shows the
+run's own noise.
 Beside the ratio of the bests, each build's ratio to the first taken round
 by round, and its median over the rounds: it does not rest on one fast
 round per build. Between row-wise builds a row's two figures in a round
@@ -117,10 +118,11 @@ def main():
 
     def paired(name, row, against):
         """The median over the rounds of name's figure over against's in the
-        same round: a slow spell that lasts a round falls on both."""
+        same round."""
         ours, theirs = each[name].get(row, {}), each[against].get(row, {})
         ratios = [ours[r] / theirs[r] for r in ours if r in theirs]
         return statistics.median(ratios) if ratios else float("nan")
+
     header = ["shape", "material"] + [f"{n} [particle-steps/s]" for n, _ in builds] + \
              [f"{n} / {reference}" for n, _ in builds[1:]] + \
              [f"{n} / {reference}, median of rounds" for n, _ in builds[1:]]
