@@ -190,8 +190,8 @@ struct StencilLanes {
   // particles seeded in it. A quadratic B-spline stencil starts at the
   // nearest node's lower neighbour, so a cell's particles at 2 a side have
   // four different ones, and runs done for every shape had slowed B-splines
-  // (README.md, The MPM solver). GIMP's seeds do share a stencil, but its 9
-  // nodes' sums (27 in 3D) have not been measured against the registers.
+  // (README.md, The MPM solver). GIMP's seeds do share a stencil, but with
+  // runs its scatters measured slower in single runs (not kept).
   static constexpr bool runs = support == 2;
 
   // The end of the run of lanes from `lane` on its stencil; every lane

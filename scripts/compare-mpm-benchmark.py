@@ -47,12 +47,12 @@ def by_rows(build):
     return "--material" in shown.stdout
 
 
-def run(build, particles, dimension, cpu, row=None, threads=()):
+def run(build, particles, dimension, cpu, row=None, options=()):
     plane = dimension == 2  # builds from before 3D take no --dimension
-    command = [program(build)] + ([] if plane else ["--dimension", "3"]) + list(threads)
+    command = [program(build)] + ([] if plane else ["--dimension", "3"]) + list(options)
     if row:
         command += ["--shape", row[0], "--material", row[1], "--threads", "1"]
-    if row or threads:
+    if row or options:
         command += ["--"]
     out = subprocess.run(command + [str(particles)], check=True, capture_output=True, text=True,
                          env=dict(os.environ, OMP_NUM_THREADS="1"),
@@ -108,7 +108,7 @@ def main():
             # not booked), each then by every such build in turn.
             measured = measured or list(
                 run(rowwise[0][1], args.particles, args.dimension, args.cpu,
-                    threads=["--threads", "1"] + (["--shape", *args.shape] if args.shape else []) +
+                    options=["--threads", "1"] + (["--shape", *args.shape] if args.shape else []) +
                     (["--material", *args.material] if args.material else [])))
             for row in measured:
                 for name, folder in rowwise:

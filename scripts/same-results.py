@@ -3,7 +3,8 @@
 bit: every snapshot each XDMF index lists (dataset by dataset), every CSV
 history row by row, and the last checkpoint's whole state; wall-clock seconds
 (columns, and wall_times.csv whole) and the program's version and build
-(attributes) are left out, so that two builds can be compared. For checking that a change moved no result: build both sides with
+(attributes) are left out, so that two builds can be compared. For checking
+that a change moved no result: build both sides with
 -DOUTBURST_NO_FP_CONTRACTION=ON (where GCC places fused multiply-adds moves
 with inlining), run the scene with each on the same thread count, then
 
