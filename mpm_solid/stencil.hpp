@@ -47,7 +47,7 @@ struct Stencil {
   // Returns false when a node of the support lies outside the (ghost-padded) grid.
   template <bool Offsets = false>
   bool compute(const Lattice<Dim>& g, const Vec<Dim>& x, double half_width) {
-    double w[Dim][support], dw[Dim][support], rel[Dim];
+    double w[Dim][support], dw[Dim][support], rel[Dim];  // dw: d w / d xi
     const double inv_h = g.inv_h;
     for (int d = 0; d < Dim; ++d) {
       const double xi = (x[d] - g.lower[d]) * inv_h + Grid<Dim>::ghost;
@@ -62,8 +62,8 @@ struct Stencil {
         for (int i = 0; i < support; ++i, ++k) {
           node[k] = first + j * row + i;
           weight[k] = w[0][i] * w[1][j];
-          gradient[0][k] = dw[0][i] * w[1][j] * inv_h;
-          gradient[1][k] = w[0][i] * dw[1][j] * inv_h;
+          gradient[0][k] = dw[0][i] * inv_h * w[1][j];
+          gradient[1][k] = dw[1][j] * inv_h * w[0][i];
           if constexpr (Offsets) offset[k] = Vec<Dim>(rel[0] + i * g.h, rel[1] + j * g.h);
         }
     } else {
@@ -72,9 +72,9 @@ struct Stencil {
           for (int i = 0; i < support; ++i, ++k) {
             node[k] = g.index({base[0] + i, base[1] + j, base[2] + l});
             weight[k] = w[0][i] * w[1][j] * w[2][l];
-            gradient[0][k] = dw[0][i] * w[1][j] * w[2][l] * inv_h;
-            gradient[1][k] = w[0][i] * dw[1][j] * w[2][l] * inv_h;
-            gradient[2][k] = w[0][i] * w[1][j] * dw[2][l] * inv_h;
+            gradient[0][k] = dw[0][i] * inv_h * w[1][j] * w[2][l];
+            gradient[1][k] = dw[1][j] * inv_h * w[0][i] * w[2][l];
+            gradient[2][k] = dw[2][l] * inv_h * w[0][i] * w[1][j];
             if constexpr (Offsets) offset[k] = Vec<Dim>(rel[0] + i * g.h, rel[1] + j * g.h, rel[2] + l * g.h);
           }
     }
@@ -105,7 +105,10 @@ struct StencilLanes {
   alignas(64) std::int64_t first[Width];     // flat index of each lane's lowest node
   alignas(64) int base[Dim][Width];          // grid coordinates of each lane's lowest node
   alignas(64) double w[Dim][support][Width];
-  alignas(64) double dw[Dim][support][Width];  // d w / d xi (per cell)
+  // d w / d x [1/m]: 1 / h taken once per lane and direction, where each
+  // node's gradient took it again (a product fewer per node and direction in
+  // the velocity gradient and force passes: README.md, The MPM solver).
+  alignas(64) double dw[Dim][support][Width];
 
   explicit StencilLanes(const Lattice<Dim>& g) : lattice(g), inv_h(g.inv_h) {
     const std::ptrdiff_t row = g.nodes_along[0], plane = Dim == 3 ? row * g.nodes_along[1] : 0;
@@ -170,7 +173,7 @@ struct StencilLanes {
 #pragma GCC unroll 3
     for (int a = 0; a < support; ++a) {
       w[d][a][lane] = wd[a];
-      dw[d][a][lane] = dwd[a];
+      dw[d][a][lane] = dwd[a] * inv_h;
     }
     flat = flat * nodes_along[d] + base;
     this->base[d][lane] = base;
@@ -219,11 +222,11 @@ struct StencilLanes {
   // d N / d x_d [1/m]
   double gradient(int d, const std::array<int, Dim>& a, int lane) const {
     if constexpr (Dim == 2)
-      return d == 0 ? dw[0][a[0]][lane] * w[1][a[1]][lane] * inv_h : w[0][a[0]][lane] * dw[1][a[1]][lane] * inv_h;
+      return d == 0 ? dw[0][a[0]][lane] * w[1][a[1]][lane] : dw[1][a[1]][lane] * w[0][a[0]][lane];
     else
-      return d == 0   ? dw[0][a[0]][lane] * w[1][a[1]][lane] * w[2][a[2]][lane] * inv_h
-             : d == 1 ? w[0][a[0]][lane] * dw[1][a[1]][lane] * w[2][a[2]][lane] * inv_h
-                      : w[0][a[0]][lane] * w[1][a[1]][lane] * dw[2][a[2]][lane] * inv_h;
+      return d == 0   ? dw[0][a[0]][lane] * w[1][a[1]][lane] * w[2][a[2]][lane]
+             : d == 1 ? dw[1][a[1]][lane] * w[0][a[0]][lane] * w[2][a[2]][lane]
+                      : dw[2][a[2]][lane] * w[0][a[0]][lane] * w[1][a[1]][lane];
   }
 };
 
