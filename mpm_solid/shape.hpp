@@ -45,6 +45,8 @@ inline bool supported(int base, int support, int nodes) {
 struct Linear {
   static constexpr int support = 2;
   static constexpr const char* name = "linear";
+  // d w / d xi is -1 at the lower node and 1 at the upper, wherever xi is.
+  static constexpr bool unit_slopes = true;
   static inline int eval(double xi, double /*lp*/, double* w, double* dw) {
     const int base = floor_int(xi);
     const double f = xi - base;

@@ -108,6 +108,10 @@ struct StencilLanes {
   // d w / d x [1/m]: 1 / h taken once per lane and direction, where each
   // node's gradient took it again (a product fewer per node and direction in
   // the velocity gradient and force passes: README.md, The MPM solver).
+  // Shapes whose d w / d xi is -1 then 1 (Shape::unit_slopes) hold w / h
+  // here instead: a gradient's factor along its own direction is then -1 / h
+  // or 1 / h, and in the plane a gradient is one entry, signed.
+  static constexpr bool unit_slopes = requires { requires Shape::unit_slopes; };
   alignas(64) double dw[Dim][support][Width];
 
   explicit StencilLanes(const Lattice<Dim>& g) : lattice(g), inv_h(g.inv_h) {
@@ -173,7 +177,7 @@ struct StencilLanes {
 #pragma GCC unroll 3
     for (int a = 0; a < support; ++a) {
       w[d][a][lane] = wd[a];
-      dw[d][a][lane] = dwd[a] * inv_h;
+      dw[d][a][lane] = (unit_slopes ? wd[a] : dwd[a]) * inv_h;
     }
     flat = flat * nodes_along[d] + base;
     this->base[d][lane] = base;
@@ -221,7 +225,15 @@ struct StencilLanes {
   }
   // d N / d x_d [1/m]
   double gradient(int d, const std::array<int, Dim>& a, int lane) const {
-    if constexpr (Dim == 2)
+    // (-1 / h) w is -(w / h) to the bit: rounding is symmetric in the sign.
+    const auto signed_along = [&](int along, double x) { return a[along] == 0 ? -x : x; };
+    if constexpr (unit_slopes && Dim == 2)
+      return d == 0 ? signed_along(0, dw[1][a[1]][lane]) : signed_along(1, dw[0][a[0]][lane]);
+    else if constexpr (unit_slopes)
+      return d == 0   ? signed_along(0, dw[1][a[1]][lane] * w[2][a[2]][lane])
+             : d == 1 ? signed_along(1, dw[0][a[0]][lane] * w[2][a[2]][lane])
+                      : signed_along(2, dw[0][a[0]][lane] * w[1][a[1]][lane]);
+    else if constexpr (Dim == 2)
       return d == 0 ? dw[0][a[0]][lane] * w[1][a[1]][lane] : dw[1][a[1]][lane] * w[0][a[0]][lane];
     else
       return d == 0   ? dw[0][a[0]][lane] * w[1][a[1]][lane] * w[2][a[2]][lane]
