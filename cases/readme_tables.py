@@ -496,6 +496,12 @@ for name, written in [
     ("mpm benchmark c772214", "compare-63e0ffd-c772214.csv"),
     ("mpm benchmark c772214 elastic", "compare-63e0ffd-c772214-elastic.csv"),
     ("mpm benchmark c772214 rounds", "compare-63e0ffd-c772214-rounds.csv"),
+    ("mpm benchmark slopes", "compare-6db9377-slopes.csv"),
+    ("mpm benchmark slopes tent", "compare-slopes-tent.csv"),
+    ("mpm benchmark 3d slopes", "compare-3d-c772214-a48b78f.csv"),
+    ("mpm benchmark a48b78f", "compare-63e0ffd-a48b78f.csv"),
+    ("mpm benchmark a48b78f elastic", "compare-63e0ffd-a48b78f-elastic.csv"),
+    ("mpm benchmark compiler options", "compare-6db9377-flags.csv"),
 ]:
     block(name, "mpm_solid/benchmark/" + written)(mpm_benchmark_builds)
 
