@@ -48,6 +48,8 @@ struct Stencil {
   template <bool Offsets = false>
   bool compute(const Lattice<Dim>& g, const Vec<Dim>& x, double half_width) {
     double w[Dim][support], dw[Dim][support], rel[Dim];  // dw: d w / d xi
+    // The gradients' products in StencilLanes' order, (d w / d xi) / h
+    // first, so that the two agree to the bit (tests/test_mpm_stencil.cpp).
     const double inv_h = g.inv_h;
     for (int d = 0; d < Dim; ++d) {
       const double xi = (x[d] - g.lower[d]) * inv_h + Grid<Dim>::ghost;
@@ -89,10 +91,11 @@ inline constexpr int chunk_lanes = 32;
 
 // The stencils of a chunk of up to Width particles, one lane per particle:
 // each direction's 1D weights, from which a node's weight and gradient are
-// formed where a pass uses them, with Stencil::compute's products in its
-// order (either gives the same bits). Nothing per node is stored and read
-// back, and the gathers' node loops run over the lanes, for the compiler to
-// vectorise (README.md, The MPM solver, has what it gained).
+// formed where a pass uses them, to the same bits as Stencil::compute's
+// (under unit slopes a factor of -1 or 1 taken as a sign). Nothing per node
+// is stored and read back, and the gathers' node loops run over the lanes,
+// for the compiler to vectorise (README.md, The MPM solver, has what it
+// gained).
 template <int Dim, class Shape, int Width = chunk_lanes>
 struct StencilLanes {
   static constexpr int support = Shape::support;
@@ -105,13 +108,15 @@ struct StencilLanes {
   alignas(64) std::int64_t first[Width];     // flat index of each lane's lowest node
   alignas(64) int base[Dim][Width];          // grid coordinates of each lane's lowest node
   alignas(64) double w[Dim][support][Width];
-  // d w / d x [1/m]: 1 / h taken once per lane and direction, where each
-  // node's gradient took it again (a product fewer per node and direction in
-  // the velocity gradient and force passes: README.md, The MPM solver).
-  // Shapes whose d w / d xi is -1 then 1 (Shape::unit_slopes) hold w / h
-  // here instead: a gradient's factor along its own direction is then -1 / h
-  // or 1 / h, and in the plane a gradient is one entry, signed.
+  // Shapes whose d w / d xi is -1 then 1 wherever the particle sits (Linear).
   static constexpr bool unit_slopes = requires { requires Shape::unit_slopes; };
+  // d w / d x [1/m]: 1 / h taken once per lane and direction, where it used
+  // to be taken at every node's gradient (a product fewer per node and
+  // direction in the velocity gradient and force passes: README.md, The MPM
+  // solver). Under unit slopes w times 1 / h instead (a product, as the
+  // gradients' is: a division would round otherwise): a gradient's factor
+  // along its own direction is then -1 / h or 1 / h, and in the plane a
+  // gradient is one of these entries, signed.
   alignas(64) double dw[Dim][support][Width];
 
   explicit StencilLanes(const Lattice<Dim>& g) : lattice(g), inv_h(g.inv_h) {
@@ -225,7 +230,8 @@ struct StencilLanes {
   }
   // d N / d x_d [1/m]
   double gradient(int d, const std::array<int, Dim>& a, int lane) const {
-    // (-1 / h) w is -(w / h) to the bit: rounding is symmetric in the sign.
+    // (-1 * (1 / h)) w is -(w (1 / h)) to the bit: rounding is symmetric in
+    // the sign.
     const auto signed_along = [&](int along, double x) { return a[along] == 0 ? -x : x; };
     if constexpr (unit_slopes && Dim == 2)
       return d == 0 ? signed_along(0, dw[1][a[1]][lane]) : signed_along(1, dw[0][a[0]][lane]);
