@@ -502,6 +502,8 @@ for name, written in [
     ("mpm benchmark a48b78f", "compare-63e0ffd-a48b78f.csv"),
     ("mpm benchmark a48b78f elastic", "compare-63e0ffd-a48b78f-elastic.csv"),
     ("mpm benchmark compiler options", "compare-6db9377-flags.csv"),
+    ("mpm benchmark a48b78f whole", "compare-63e0ffd-a48b78f-whole.csv"),
+    ("mpm benchmark a48b78f whole again", "compare-63e0ffd-a48b78f-whole-again.csv"),
 ]:
     block(name, "mpm_solid/benchmark/" + written)(mpm_benchmark_builds)
 

@@ -20,8 +20,12 @@ are a few seconds apart, so a slow spell falls on both; a whole-run
 build's figure comes from the round's start, up to a minute before.
 --shape and --material (either repeated for more) choose the rows of the
 row-wise builds; whole-run builds measure their default rows.
+--whole runs every build whole, the row-wise ones too: against an older
+reference each round's figures then come from one program shape (a whole
+run lasts about twenty seconds, a row-wise one a second or two), run back
+to back, for the medians to pair.
 
-usage: compare-mpm-benchmark.py [--particles N] [--rounds R] [--dimension 2|3] [--cpu C] [--shape S] [--material M] [--csv FILE] NAME=BUILD_DIR ...
+usage: compare-mpm-benchmark.py [--particles N] [--rounds R] [--dimension 2|3] [--cpu C] [--shape S] [--material M] [--whole] [--csv FILE] NAME=BUILD_DIR ...
   e.g. compare-mpm-benchmark.py before=/tmp/old/build after=build
 """
 import argparse
@@ -79,6 +83,8 @@ def main():
                         help="the row-wise builds measure this shape (repeat for more; default: the benchmark's)")
     parser.add_argument("--material", action="append",
                         help="the row-wise builds measure this material (repeat for more; default: the benchmark's)")
+    parser.add_argument("--whole", action="store_true",
+                        help="run every build whole, once a round, as older builds are run")
     parser.add_argument("--csv", help="also write the table here")
     args = parser.parse_args()
     if args.cpu is not None and args.cpu not in os.sched_getaffinity(0):
@@ -87,7 +93,9 @@ def main():
     names = [name for name, _ in builds]
     if len(set(names)) < len(names):
         sys.exit("each NAME once: the figures are kept by name (a build measured twice takes two names)")
-    rowwise = [(name, folder) for name, folder in builds if by_rows(folder)]
+    rowwise = [] if args.whole else [(name, folder) for name, folder in builds if by_rows(folder)]
+    if (args.shape or args.material) and args.whole:
+        sys.exit("--whole runs each build's default rows: --shape and --material choose none")
     if (args.shape or args.material) and not rowwise:
         sys.exit("--shape and --material choose the rows of builds whose mpm-benchmark takes them; none here does")
     whole = [(name, folder) for name, folder in builds if (name, folder) not in rowwise]
