@@ -48,8 +48,9 @@ struct Stencil {
   template <bool Offsets = false>
   bool compute(const Lattice<Dim>& g, const Vec<Dim>& x, double half_width) {
     double w[Dim][support], dw[Dim][support], rel[Dim];  // dw: d w / d xi
-    // The gradients' products in StencilLanes' order, (d w / d xi) / h
-    // first, so that the two agree to the bit (tests/test_mpm_stencil.cpp).
+    // The gradients' products in StencilLanes' order, (d w / d xi) times
+    // 1 / h first, so that the two agree to the bit
+    // (tests/test_mpm_stencil.cpp).
     const double inv_h = g.inv_h;
     for (int d = 0; d < Dim; ++d) {
       const double xi = (x[d] - g.lower[d]) * inv_h + Grid<Dim>::ghost;
