@@ -24,6 +24,9 @@ row-wise builds; whole-run builds measure their default rows.
 reference each round's figures then come from one program shape (a whole
 run lasts about twenty seconds, a row-wise one a second or two), run back
 to back, for the medians to pair.
+The printout's first line and the CSV's last column name the processor:
+the ratios depend on it (README.md, "The same builds on another
+processor").
 
 usage: compare-mpm-benchmark.py [--particles N] [--rounds R] [--dimension 2|3] [--cpu C] [--shape S] [--material M] [--whole] [--csv FILE] NAME=BUILD_DIR ...
   e.g. compare-mpm-benchmark.py before=/tmp/old/build after=build
@@ -36,7 +39,7 @@ import statistics
 import subprocess
 import sys
 
-from builds import named_builds  # scripts/builds.py
+from builds import host, named_builds  # scripts/builds.py
 
 ROW = re.compile(r"^\s*(\d+)\s+(\S+)\s+(\S+)\s+([0-9.e+]+)")
 
@@ -133,20 +136,21 @@ def main():
 
     header = ["shape", "material"] + [f"{n} [particle-steps/s]" for n, _ in builds] + \
              [f"{n} / {reference}" for n, _ in builds[1:]] + \
-             [f"{n} / {reference}, median of rounds" for n, _ in builds[1:]]
+             [f"{n} / {reference}, median of rounds" for n, _ in builds[1:]] + ["host"]
+    machine = host()
     rows = []
     # The rows the row-wise builds measured (an older reference, run whole,
     # may lack some, whose ratios then read nan), else the reference's.
     for row in measured or best[reference]:
         values = [best[n].get(row, float("nan")) for n, _ in builds]
         rows.append(list(row) + [f"{v:.4g}" for v in values] + [f"{v / values[0]:.3f}" for v in values[1:]] +
-                    [f"{paired(n, row, reference):.3f}" for n, _ in builds[1:]])
+                    [f"{paired(n, row, reference):.3f}" for n, _ in builds[1:]] + [machine])
     pinned = "" if args.cpu is None else f", on core {args.cpu}"
-    print(f"best of {args.rounds} rounds, {args.particles} particles, 1 thread{pinned}, {args.dimension}D")
-    print("| " + " | ".join(header) + " |")
-    print("|" + "---|" * len(header))
+    print(f"best of {args.rounds} rounds, {args.particles} particles, 1 thread{pinned}, {args.dimension}D, {machine}")
+    print("| " + " | ".join(header[:-1]) + " |")
+    print("|" + "---|" * (len(header) - 1))
     for r in rows:
-        print("| " + " | ".join(r) + " |")
+        print("| " + " | ".join(r[:-1]) + " |")
     if args.csv:
         with open(args.csv, "w", newline="") as f:
             w = csv.writer(f)
