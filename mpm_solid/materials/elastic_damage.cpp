@@ -414,14 +414,18 @@ Dissipation ElasticDamage<Dim>::update_alone(Particles<Dim>& p, int i) const {
 // Most of the coal, most of the time, does not crack further: settling then
 // sets its acting stress, returns a compressive one that lies beyond the
 // friction cone to it (the sliding of broken coal) and caps a broken
-// particle's bulking. That is done for a chunk at once over SIMD lanes, each
-// particle's arithmetic settle's and drucker_prager_return's written out in
-// their order (Eigen's, for the deviator's squared norm), so that the lanes
-// move no result where the compiler fuses no products of its own
-// (-DOUTBURST_NO_FP_CONTRACTION=ON; with its fused multiply-adds, placed
+// particle's bulking. All but the cap is done for a chunk at once over SIMD
+// lanes, each particle's arithmetic settle's and drucker_prager_return's
+// written out in their order (Eigen's, for the deviator's squared norm), so
+// that the lanes move no result where the compiler fuses no products of its
+// own (-DOUTBURST_NO_FP_CONTRACTION=ON; with its fused multiply-adds, placed
 // apart in vector and scalar code, an ulp). settle itself runs after for the
-// particles whose damage grew, and the dissipation is summed in the members'
-// order.
+// particles whose damage grew, the cap for the others, and the dissipation
+// is summed in the members' order. The cap is kept out of the lanes: its
+// load of the initial volume, made only where the damage is full, takes a
+// masked load there, which GCC 12 did not vectorise for AVX2's 128-bit
+// vectors, and the whole loop stayed scalar (README.md, "The same builds on
+// another processor").
 template <int Dim>
 template <bool Drawn, bool Band, class Index>
 Dissipation ElasticDamage<Dim>::settle_plane(Particles<Dim>& p, std::span<const int> members, Index index) const {
@@ -501,17 +505,18 @@ Dissipation ElasticDamage<Dim>::settle_plane(Particles<Dim>& p, std::span<const 
     e[1] = slides != 0 ? e1 : x1;
     e[2] = slides != 0 ? e2 : x2;
     e[3] = slides != 0 ? e3 : x3;
-    const double bulked = d >= 1 ? std::min(volume[i], bulking * volume0[i]) : volume[i];
-    volume[i] = d == previous ? bulked : volume[i];
     const double back_zz = crack(r_zz, open);
     effective_zz[i] = slides != 0 ? back_zz : zz;
   }
   Dissipation total;
   for (int k = 0; k < n; ++k) {
-    if (verdict[k] == 0)
-      total += update_alone(p, static_cast<int>(index(k)));
-    else if (verdict[k] == 2)
-      total += Dissipation{plastic[k], 0.0};
+    const auto i = static_cast<int>(index(k));
+    if (verdict[k] == 0) {
+      total += update_alone(p, i);
+    } else {
+      if (verdict[k] == 2) total += Dissipation{plastic[k], 0.0};
+      if (damaged[i] >= 1) volume[i] = std::min(volume[i], bulking * volume0[i]);
+    }
   }
   return total;
 }
