@@ -430,9 +430,13 @@ def grid_transfer(rows):
 
 @block("mpm benchmark against earlier builds", "mpm_solid/benchmark/compare-63e0ffd-cd51f91-64cd2b9.csv")
 def mpm_benchmark_builds(rows):
-    """scripts/compare-mpm-benchmark.py's CSV: each build's best throughput and its ratio to the first."""
-    header = list(rows[0].keys())
-    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    """scripts/compare-mpm-benchmark.py's CSV: each build's best throughput and its ratio to the first, and
+    the processor, where the CSV names it (runs from before it did were on the one of "The same builds on another
+    processor")."""
+    header = [h for h in rows[0].keys() if h != "host"]
+    hosts = sorted({r["host"] for r in rows if r.get("host")})
+    lines = [f"On {', '.join(hosts)}:", ""] if hosts else []
+    lines += ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
     for r in rows:
         lines.append("| " + " | ".join(r[h] if "[" not in h else sci(float(r[h]), 2) for h in header) + " |")
     return lines
@@ -504,6 +508,8 @@ for name, written in [
     ("mpm benchmark compiler options", "compare-6db9377-flags.csv"),
     ("mpm benchmark a48b78f whole", "compare-63e0ffd-a48b78f-whole.csv"),
     ("mpm benchmark a48b78f whole again", "compare-63e0ffd-a48b78f-whole-again.csv"),
+    ("mpm benchmark a48b78f avx2", "compare-63e0ffd-a48b78f-epyc.csv"),
+    ("mpm benchmark settle avx2", "compare-a48b78f-settle-avx2.csv"),
 ]:
     block(name, "mpm_solid/benchmark/" + written)(mpm_benchmark_builds)
 
