@@ -431,11 +431,11 @@ def grid_transfer(rows):
 @block("mpm benchmark against earlier builds", "mpm_solid/benchmark/compare-63e0ffd-cd51f91-64cd2b9.csv")
 def mpm_benchmark_builds(rows):
     """scripts/compare-mpm-benchmark.py's CSV: each build's best throughput and its ratio to the first, and
-    the processor, where the CSV names it (runs from before it did were on the one of "The same builds on another
-    processor")."""
+    the processor, where the CSV names it. CSVs from before name none; those runs were on AVX-512 hosts
+    (README.md, "The same builds on another processor")."""
     header = [h for h in rows[0].keys() if h != "host"]
     hosts = sorted({r["host"] for r in rows if r.get("host")})
-    lines = [f"On {', '.join(hosts)}:", ""] if hosts else []
+    lines = [f"On {'; '.join(hosts)}:", ""] if hosts else []
     lines += ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
     for r in rows:
         lines.append("| " + " | ".join(r[h] if "[" not in h else sci(float(r[h]), 2) for h in header) + " |")

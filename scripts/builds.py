@@ -1,6 +1,7 @@
 """The NAME=BUILD_DIR arguments of the scripts that compare builds, and the
 machine they ran on."""
 import os
+import platform
 import sys
 
 
@@ -16,24 +17,28 @@ def named_builds(items, program):
 
 
 def host():
-    """The processor a comparison ran on: its model, its widest vector
-    extension and the cores this process may use. A build's ratio to
-    another depends on it (README.md, "The same builds on another
-    processor"): kernels vectorised over particles gain more from 512-bit
-    vectors than from 128-bit ones."""
-    model, flags = "unknown processor", set()
+    """The processor a comparison ran on: its model (with family and model
+    numbers, since a virtual machine may report no more than a brand name),
+    its widest vector extension and the logical CPUs this process may use. A
+    build's ratio to another depends on it (README.md, "The same builds on
+    another processor"): kernels vectorised over particles gain more from
+    256-bit vectors than from 128-bit ones."""
+    fields = {}
     try:
         with open("/proc/cpuinfo") as f:
             for line in f:
-                key, _, value = line.partition(":")
-                if key.strip() == "model name":
-                    model = value.strip()
-                elif key.strip() == "flags":
-                    flags = set(value.split())
-                if model != "unknown processor" and flags:
-                    break
+                key, sep, value = line.partition(":")
+                if not sep and fields:
+                    break  # the first processor's entry is enough
+                fields.setdefault(key.strip(), value.strip())
     except OSError:
         pass
-    vectors = next((name for flag, name in [("avx512f", "AVX-512"), ("avx2", "AVX2"), ("avx", "AVX")]
-                    if flag in flags), "SSE")
-    return f"{model}, {vectors}, {len(os.sched_getaffinity(0))} cores"
+    model = fields.get("model name") or platform.processor() or platform.machine() or "unknown processor"
+    if "cpu family" in fields and "model" in fields:
+        model += f" (family {fields['cpu family']}, model {fields['model']})"
+    flags = set(fields.get("flags", fields.get("Features", "")).split())
+    vectors = next((name for flag, name in [("avx512f", "AVX-512"), ("avx2", "AVX2"), ("avx", "AVX"),
+                                             ("sse2", "SSE2"), ("sve", "SVE"), ("asimd", "NEON")]
+                    if flag in flags), "vector extensions unknown")
+    cpus = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
+    return f"{model}, {vectors}, {cpus} CPUs"
