@@ -18,7 +18,8 @@ namespace outburst::mpm {
 
 // floor(x) as an int: std::floor over SIMD lanes needs -fno-trapping-math
 // from GCC, and without it the stencils' loops over a chunk's particles stayed
-// scalar. The truncation, one lower where it rounded up (x negative and not
+// scalar. The build takes that flag now (CMakeLists.txt), for other loops;
+// floor_int keeps the stencils from depending on it. The truncation, one lower where it rounded up (x negative and not
 // whole), is the same integer. x must lie within int's range, where the
 // conversion is defined: the solver's stencils read the particles and
 // tracers a scene placed on the grid, and after each step only the

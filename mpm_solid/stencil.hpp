@@ -158,8 +158,9 @@ struct StencilLanes {
     const std::array<int, Dim> nodes_along = lattice.nodes_along;
     // The directions written out (along<d>), and floor_int for std::floor:
     // as a loop, the directions left each lane's weights to scatter stores,
-    // and GCC takes std::floor over lanes only without trapping math; either
-    // kept this loop scalar.
+    // and GCC takes std::floor over lanes only without trapping math (which
+    // the build now turns off, for other loops); either kept this loop
+    // scalar.
     const double* position = x->data();
 #pragma omp simd
     for (int lane = 0; lane < lanes; ++lane) {

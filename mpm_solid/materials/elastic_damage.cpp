@@ -422,10 +422,10 @@ Dissipation ElasticDamage<Dim>::update_alone(Particles<Dim>& p, int i) const {
 // apart in vector and scalar code, an ulp). settle itself runs after for the
 // particles whose damage grew, the cap for the others, and the dissipation
 // is summed in the members' order. The cap is kept out of the lanes: its
-// load of the initial volume, made only where the damage is full, takes a
-// masked load there, which GCC 12 did not vectorise for AVX2's 128-bit
-// vectors, and the whole loop stayed scalar (README.md, "The same builds on
-// another processor").
+// load of the initial volume, made only where the damage is full, would
+// need a masked load in them, which GCC 12 refused for the 128-bit vectors
+// of its Zen 1 tuning, and the whole loop stayed scalar there (README.md,
+// "The same builds on another processor").
 template <int Dim>
 template <bool Drawn, bool Band, class Index>
 Dissipation ElasticDamage<Dim>::settle_plane(Particles<Dim>& p, std::span<const int> members, Index index) const {
