@@ -578,6 +578,12 @@ def mpm_benchmark(rows):
     return lines
 
 
+@block("mpm benchmark avx2", "mpm_solid/benchmark/mpm-benchmark-avx2.csv")
+def mpm_benchmark_avx2(rows):
+    """mpm-benchmark's own CSV from the AVX2 processor of "The same builds on another processor"."""
+    return mpm_benchmark(rows)
+
+
 @block("mpm benchmark 3d", "mpm_solid/benchmark/mpm-benchmark-3d.csv", "mpm_solid/benchmark/mpm-benchmark.csv")
 def mpm_benchmark_3d(rows, plane):
     """The 3D rows, and what a 3D particle-step costs against a plane one (one thread)."""
