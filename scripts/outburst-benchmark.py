@@ -12,7 +12,9 @@ usage: scripts/outburst-benchmark.py [--threads 2] [--only first_second|to_rest]
 --set adds a scene override (as the outburst program's --set) to every run, after the case's own: a
 longer step, say, costed against the shipped one's rows of another run.
 Run it on an idle machine: two threads that share their cores with other
-work wait on each other at every barrier.
+work wait on each other at every barrier. The processor is printed first
+and written as the CSV's last column, host: the wall times depend on it
+(README.md, "The same builds on another processor").
 """
 import argparse
 import csv
@@ -27,7 +29,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, ROOT)
 from cases.effect_cost import particle_steps  # noqa: E402
-from builds import named_builds  # noqa: E402 (scripts/builds.py)
+from builds import host, named_builds  # noqa: E402 (scripts/builds.py)
 
 SCENE = os.path.join(ROOT, "cases", "outburst", "outburst.toml")
 # The run to rest: cases/outburst/run-to-rest.sh's overrides.
@@ -102,13 +104,15 @@ def main():
     args = parser.parse_args()
     builds = named_builds(args.builds, os.path.join("coupler", "outburst"))
     rows = []
+    machine = host()
+    print(f"on {machine}", flush=True)
     with tempfile.TemporaryDirectory() as temporary:
         scratch = args.out or temporary
         for case in [args.only] if args.only else list(CASES):
             for name, build in builds:
                 r = run(build, case, args.threads, os.path.join(scratch, f"{name}_{case}"), args.overrides)
                 r["standalone_particle_steps_per_s"] = standalone(build, r["particles"], args.threads)
-                rows.append({"case": case, "build": name, "threads": args.threads} | r)
+                rows.append({"case": case, "build": name, "threads": args.threads} | r | {"host": machine})
                 print(f"{case} {name}: {r['wall_s']:.1f} s wall for {r['simulated_s']:.3g} s, solid "
                       f"{r['solid_s']:.1f} s at {r['coupled_particle_steps_per_s']:.3g} particle-steps/s "
                       f"(standalone {r['standalone_particle_steps_per_s']:.3g}: "
