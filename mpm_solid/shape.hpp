@@ -16,21 +16,21 @@
 
 namespace outburst::mpm {
 
-// floor(x) as an int: std::floor over SIMD lanes needs -fno-trapping-math
-// from GCC, and without it the stencils' loops over a chunk's particles stayed
+// floor(x) as an int: std::floor over SIMD lanes needs -fno-trapping-math from
+// GCC, and without it the stencils' loops over a chunk's particles stayed
 // scalar. The build takes that flag now (CMakeLists.txt), for other loops;
-// floor_int keeps the stencils from depending on it. The truncation, one lower where it rounded up (x negative and not
-// whole), is the same integer. x must lie within int's range, where the
-// conversion is defined: the solver's stencils read the particles and
-// tracers a scene placed on the grid, and after each step only the
-// particles still on it (the census removes the ones that left and stops
-// the run at a non-finite position; the move's mapping ahead skips the
-// chunks the census found such a particle in). Holding x there first cost every
-// kernel 15 % (mpm_solid/benchmark/compare-63e0ffd-de26bb6-290380f-e0a5804.csv):
-// GCC 12 sinks the conversion into the select's branches, where it may
-// trap, and keeps the stencils' loops scalar again. Near int's ends one
-// lower wraps: unsigned, so that the wrap is defined, and the support check
-// refuses it (supported()).
+// floor_int keeps the stencils from depending on it. The truncation, one lower
+// where it rounded up (x negative and not whole), is the same integer. x must
+// lie within int's range, where the conversion is defined: the solver's
+// stencils read the particles and tracers a scene placed on the grid, and after
+// each step only the particles still on it (the census removes the ones that
+// left and stops the run at a non-finite position; the move's mapping ahead
+// skips the chunks the census found such a particle in). Holding x there first
+// cost every kernel 15 %
+// (mpm_solid/benchmark/compare-63e0ffd-de26bb6-290380f-e0a5804.csv): GCC 12
+// sinks the conversion into the select's branches, where it may trap, and keeps
+// the stencils' loops scalar again. Near int's ends one lower wraps: unsigned,
+// so that the wrap is defined, and the support check refuses it (supported()).
 inline int floor_int(double x) {
   const int t = static_cast<int>(x);
   return static_cast<int>(static_cast<unsigned>(t) - (x < t));
