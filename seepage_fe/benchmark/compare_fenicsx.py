@@ -20,7 +20,9 @@ one's (max |u - u_direct| / max |u_direct|). Each timed step is a whole Newton s
 run's mean; the mesh, the forms' compilation and a first step are not timed. Rounds
 alternate ours and theirs and each keeps its best round, since the machine may be shared.
 
-Without dolfinx it says so and exits 0: this is a benchmark, not a test.
+Without dolfinx it says so and exits 0: this is a benchmark, not a test. The processor is
+printed first and written as the CSV's last column, host: the ratios depend on it (README.md,
+"The same builds on another processor").
 """
 import argparse
 import csv
@@ -32,6 +34,9 @@ import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 TOP = os.path.dirname(os.path.dirname(HERE))
+sys.path.insert(0, os.path.join(TOP, "scripts"))
+from builds import host  # noqa: E402 (scripts/builds.py)
+
 TIME_STEP = 1e-3
 
 
@@ -167,8 +172,9 @@ def main(argv=None):
     fenicsx_names = ["FEniCSx, 1 process", f"FEniCSx, {args.threads} processes"]
     contenders = mine_names + fenicsx_names
     rows = []
+    machine = host()
     print(f"FEniCSx {dolfinx.__version__}; {args.rounds} rounds of {args.steps} steps, best kept; "
-          f"{args.threads} threads")
+          f"{args.threads} threads; on {machine}")
     for cells in args.cells:
         best = {c: None for c in contenders}
 
@@ -191,7 +197,8 @@ def main(argv=None):
         for c in contenders:
             rows.append({"unknowns": (cells + 1) ** 2, "contender": c, "threads": args.threads,
                          "newton_iteration_s": f"{best[c][0]:.6g}", "newton_iterations": f"{best[c][1]:.3g}",
-                         "fenicsx_over_this": f"{reference / best[c][0]:.3f}", "difference": best[c][2]})
+                         "fenicsx_over_this": f"{reference / best[c][0]:.3f}", "difference": best[c][2],
+                         "host": machine})
     print(f"\n{'unknowns':>9} {'contender':<36} {'per Newton it. [s]':>18} {'its/step':>8} {'FEniCSx/this':>12} "
           f"{'differs':>9}")
     for r in rows:
