@@ -136,7 +136,7 @@ def main():
 
     header = ["shape", "material"] + [f"{n} [particle-steps/s]" for n, _ in builds] + \
              [f"{n} / {reference}" for n, _ in builds[1:]] + \
-             [f"{n} / {reference}, median of rounds" for n, _ in builds[1:]] + ["host"]
+             [f"{n} / {reference}, median of rounds" for n, _ in builds[1:]]
     machine = host()
     rows = []
     # The rows the row-wise builds measured (an older reference, run whole,
@@ -144,18 +144,18 @@ def main():
     for row in measured or best[reference]:
         values = [best[n].get(row, float("nan")) for n, _ in builds]
         rows.append(list(row) + [f"{v:.4g}" for v in values] + [f"{v / values[0]:.3f}" for v in values[1:]] +
-                    [f"{paired(n, row, reference):.3f}" for n, _ in builds[1:]] + [machine])
+                    [f"{paired(n, row, reference):.3f}" for n, _ in builds[1:]])
     pinned = "" if args.cpu is None else f", on core {args.cpu}"
     print(f"best of {args.rounds} rounds, {args.particles} particles, 1 thread{pinned}, {args.dimension}D, {machine}")
-    print("| " + " | ".join(header[:-1]) + " |")
-    print("|" + "---|" * (len(header) - 1))
+    print("| " + " | ".join(header) + " |")
+    print("|" + "---|" * len(header))
     for r in rows:
-        print("| " + " | ".join(r[:-1]) + " |")
+        print("| " + " | ".join(r) + " |")
     if args.csv:
         with open(args.csv, "w", newline="") as f:
             w = csv.writer(f)
-            w.writerow(header)
-            w.writerows(rows)
+            w.writerow(header + ["host"])
+            w.writerows(r + [machine] for r in rows)
 
 
 if __name__ == "__main__":
