@@ -120,6 +120,169 @@ TEST_CASE("Drucker-Prager below the yield surface is elastic", "[mpm][material]"
   CHECK(a.plastic_strain[0] == 0);
 }
 
+TEST_CASE("Drucker-Prager: a chunk screened over SIMD lanes ends as each particle's trial returned alone",
+          "[mpm][material]") {
+  // A chunk and a few more particles along their own strain paths: elastic,
+  // onto the cone in compression, past the apex in tension, unloading, and
+  // one held in hydrostatic tension beyond the apex (a zero multiplier that
+  // still does plastic work). In the plane, lanes screen out a chunk's
+  // particles that surely lie inside the cone and the public return takes
+  // the rest; the reference is that return applied to every particle's
+  // elastic trial, formed here in another translation unit (its fused
+  // multiply-adds may sit elsewhere: an ulp, which a return's sum of a mean
+  // and a deviator of nearly opposite size makes 1e-15 of the stress a few
+  // times over). Members reached through a list (evens, then odds) end the
+  // same.
+  const double dilation = GENERATE(0.0, 10 * deg);
+  INFO("dilation angle " << dilation / deg << " deg");
+  const DruckerPrager<2> m("coal", coal, 0.3e6, 30 * deg, dilation, DruckerPragerFit::Kind::outer);
+  const int n = chunk_size + 5;
+  Particles<2> together;
+  for (int k = 0; k < n; ++k) together.add({0.1 * k, 0}, {0, 0}, 1, 1, 0.25, Mat<2>::Zero(), 0, 0);
+  std::vector<int> members(n), evens, odds;
+  std::iota(members.begin(), members.end(), 0);
+  for (int k = 0; k < n; ++k) (k % 2 ? odds : evens).push_back(k);
+  m.create_fields(together, members);
+  together.need_velocity_gradients();
+  std::vector<Mat<2>> l(n);
+  for (int k = 0; k < n; ++k) {
+    const double size = 0.05 + (k % 8) / 8.0, angle = 0.7 * k;
+    const double a = size * std::sin(1.3 * k), b = size * std::cos(2.1 * k), spin = 0.2 * std::sin(0.5 * k);
+    Mat<2> r;
+    r << std::cos(angle), -std::sin(angle), std::sin(angle), std::cos(angle);
+    l[k] = r * Vec<2>(a, b).asDiagonal() * r.transpose();
+    l[k](0, 1) -= spin, l[k](1, 0) += spin;
+  }
+  l[0].setZero();               // never loaded
+  l[1] = Mat<2>::Identity();    // spreading: past the apex
+  l[2] = -Mat<2>::Identity();   // squeezed equally: no shear, elastic
+  l[3].setZero();               // held in hydrostatic tension beyond the apex
+  const double apex = m.k() / m.alpha(), bulk = m.lame_lambda() + 2.0 / 3.0 * m.shear_modulus();
+  // A power of two past the apex: the mean of three is exact, the deviator zero.
+  const double held = std::ldexp(1.0, std::ilogb(apex) + 1);
+  together.stress[3] = held * Mat<2>::Identity();
+  together.stress_zz[3] = held;
+  const double per_multiplier = std::sqrt(2.0 / 3.0 * (0.5 + std::pow(
+      DruckerPragerFit::coefficients(DruckerPragerFit::Kind::outer, 0, dilation).first, 2) / 3));
+  int returned = 0, apexes = 0;
+  bool held_work = false;
+  bool first = true;
+  for (const double sign : {1.0, 1.0, -0.5}) {
+    for (int k = 0; k < n; ++k) together.velocity_gradient[k] = sign * l[k];
+    for (int s = 0; s < 60; ++s, first = false) {
+      Particles<2> trial = together;
+      deform_and_trial(trial, std::span<const int>(members), 2e-6, m.lame_lambda(), m.shear_modulus(), nullptr,
+                       trial.stress, trial.stress_zz);
+      std::vector<double> multiplier(n);
+      double work_sum = 0, scale_sum = 0;
+      for (int k = 0; k < n; ++k) {
+        double work = 0;
+        multiplier[k] = m.return_map(trial.stress[k], trial.stress_zz[k], &work);
+        work_sum += trial.volume[k] * work;
+        scale_sum += trial.volume[k] * trial.stress[k].squaredNorm() / m.shear_modulus();
+        if (k == 3 && first) {
+          // The mean stress let go to the apex: work apex (held - apex) / K.
+          CHECK(multiplier[k] == 0);
+          CHECK(work == Approx(apex * (held - apex) / bulk).epsilon(1e-12));
+          held_work = work > 0;
+        }
+      }
+      const std::vector<double> strain_before = together.plastic_strain;
+      Dissipation d;
+      if (s % 2) {
+        d = m.update_stress(together, members, 2e-6);
+      } else {
+        d += m.update_stress(together, evens, 2e-6);
+        d += m.update_stress(together, odds, 2e-6);
+      }
+      CHECK(d.plastic == Approx(work_sum).margin(1e-12 * scale_sum));
+      for (int k = 0; k < n; ++k) {
+        CAPTURE(k, s, sign);
+        const double size = trial.stress[k].norm() + std::abs(trial.stress_zz[k]);
+        CHECK((together.stress[k] - trial.stress[k]).norm() <= 1e-13 * size);
+        CHECK(std::abs(together.stress_zz[k] - trial.stress_zz[k]) <= 1e-13 * size);
+        CHECK(together.plastic_strain[k] - strain_before[k] ==
+              Approx(per_multiplier * multiplier[k]).margin(1e-13 * (size / m.shear_modulus())));
+        returned += multiplier[k] > 0;
+        apexes += multiplier[k] > 0 && together.stress[k](0, 1) == 0 && together.stress[k](0, 0) == apex;
+      }
+    }
+  }
+  CHECK(held_work);
+  CHECK(returned > n);     // many particles on the cone, over many steps
+  CHECK(apexes > 0);       // some of them at its apex
+  CHECK(together.plastic_strain[0] == 0);
+  CHECK(together.plastic_strain[2] == 0);
+}
+
+TEST_CASE("Drucker-Prager: the lanes' screen passes no stress the return would move, however near the cone",
+          "[mpm][material]") {
+  // Stresses on, just inside and just outside the cone (sqrt(J2) = (k -
+  // alpha mean)(1 + e), e from -1e-9 to 1e-9 and 0), in tension and
+  // compression, with a chunk's worth of deviator directions and an
+  // out-of-plane part. With no velocity gradient the trial is the stress
+  // itself, so the update must give what the public return gives, to the bit.
+  const DruckerPrager<2> m("coal", coal, 0.3e6, 30 * deg, 10 * deg, DruckerPragerFit::Kind::outer);
+  const double apex = m.k() / m.alpha();
+  Particles<2> p;
+  std::vector<Mat<2>> expected;
+  std::vector<double> expected_zz;
+  int moved = 0;
+  for (const double mean : {-50 * apex, -apex, 0.0, 0.5 * apex, 0.999 * apex}) {
+    for (const double e : {-1e-9, -1e-12, -1e-15, -2e-16, 0.0, 2e-16, 1e-15, 1e-12, 1e-9}) {
+      for (int d = 0; d < 8; ++d) {
+        // A deviator (xx, yy, xy, zz summing to zero on the diagonal) of unit sqrt(J2).
+        const double a = std::cos(0.9 * d), b = std::sin(0.9 * d), c = 0.3 * std::sin(2.3 * d);
+        Mat<2> dev;
+        dev << a, c, c, b;
+        const double dev_zz = -(a + b);
+        const double unit = std::sqrt(0.5 * (dev.squaredNorm() + dev_zz * dev_zz));
+        const double size = (m.k() - m.alpha() * mean) * (1 + e) / unit;
+        const Mat<2> s = mean * Mat<2>::Identity() + size * dev;
+        const double s_zz = mean + size * dev_zz;
+        p.add({0.1 * static_cast<double>(p.size()), 0}, {0, 0}, 1, 1, 0.25, s, s_zz, 0);
+        Mat<2> r = s;
+        double r_zz = s_zz;
+        moved += m.return_map(r, r_zz) > 0 || r != s || r_zz != s_zz;
+        expected.push_back(r);
+        expected_zz.push_back(r_zz);
+      }
+    }
+  }
+  std::vector<int> members(p.size());
+  std::iota(members.begin(), members.end(), 0);
+  m.create_fields(p, members);
+  p.need_velocity_gradients();
+  for (auto& l : p.velocity_gradient) l.setZero();
+  m.update_stress(p, members, 1e-6);
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    CAPTURE(k);
+    CHECK(p.stress[k] == expected[k]);
+    CHECK(p.stress_zz[k] == expected_zz[k]);
+  }
+  // Some of the states the return moves, some it leaves.
+  CHECK(moved > 0);
+  CHECK(moved < static_cast<int>(p.size()));
+}
+
+TEST_CASE("Drucker-Prager: a NaN stress in a chunk stays NaN and leaves its neighbours alone", "[mpm][material]") {
+  // The lanes decide by f <= 0, as the scalar return does: a NaN trial is
+  // not taken for an elastic one, so the solver's health check still sees it.
+  const DruckerPrager<2> m("coal", coal, 0.3e6, 30 * deg, 0.0, DruckerPragerFit::Kind::outer);
+  Particles<2> p;
+  for (int k = 0; k < 3; ++k) p.add({0.1 * k, 0}, {0, 0}, 1, 1, 0.25, Mat<2>::Zero(), 0, 0);
+  const std::vector<int> members{0, 1, 2};
+  m.create_fields(p, members);
+  p.need_velocity_gradients();
+  for (auto& l : p.velocity_gradient) l << -1e-3, 0, 0, 0;
+  p.stress[1](0, 0) = std::nan("");
+  m.update_stress(p, members, 1.0);
+  CHECK(std::isnan(p.stress[1](1, 1)));
+  CHECK(std::isnan(p.plastic_strain[1]));
+  CHECK(p.stress[0] == p.stress[2]);
+  CHECK(std::isfinite(p.stress[0].norm()));
+}
+
 namespace {
 
 const DamageParameters coal_damage{1e6, 30 * deg, 0.2e6, 0.1, 5.0, std::nullopt};
