@@ -428,15 +428,20 @@ def grid_transfer(rows):
     return [line for piece in pieces for line in wrap(piece, 80, bullet=True)]
 
 
+def on_host(rows):
+    """A line naming the processors a CSV's rows ran on, and a blank one; none where its rows name none
+    (CSVs written before the benchmarks named it: scripts/builds.py's host(), common/host.hpp)."""
+    hosts = sorted({r["host"] for r in rows if r.get("host")})
+    return [f"On {'; '.join(hosts)}:", ""] if hosts else []
+
+
 @block("mpm benchmark against earlier builds", "mpm_solid/benchmark/compare-63e0ffd-cd51f91-64cd2b9.csv")
 def mpm_benchmark_builds(rows):
     """scripts/compare-mpm-benchmark.py's CSV: each build's best throughput and its ratio to the first, and
     the processor, where the CSV names it. CSVs from before name none; those runs were on AVX-512 hosts
     (README.md, "The same builds on another processor")."""
     header = [h for h in rows[0].keys() if h != "host"]
-    hosts = sorted({r["host"] for r in rows if r.get("host")})
-    lines = [f"On {'; '.join(hosts)}:", ""] if hosts else []
-    lines += ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    lines = on_host(rows) + ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
     for r in rows:
         lines.append("| " + " | ".join(r[h] if "[" not in h else sci(float(r[h]), 2) for h in header) + " |")
     return lines
@@ -565,9 +570,10 @@ def outburst_limits(rows):
 @block("mpm benchmark", "mpm_solid/benchmark/mpm-benchmark.csv")
 def mpm_benchmark(rows):
     materials = ["elastic", "drucker_prager", "elastic_damage"]
-    lines = ["| particles | shape | " + " | ".join(f"{m}: 1 / 2 threads (speed-up)" for m in materials) +
-             " | bytes per particle (own + grid) |",
-             "|---|---|---|---|---|---|"]
+    lines = on_host(rows) + [
+        "| particles | shape | " + " | ".join(f"{m}: 1 / 2 threads (speed-up)" for m in materials) +
+        " | bytes per particle (own + grid) |",
+        "|---|---|---|---|---|---|"]
     cases = {}
     for r in rows:
         cases.setdefault((int(r["particles"]), r["shape"]), {})[r["material"]] = r
@@ -615,7 +621,7 @@ ORDERINGS = ["amd", "metis", "nesdis", "cholmod_default"]
 @block("seepage orderings", "seepage_fe/benchmark/orderings.csv")
 def seepage_orderings(rows):
     """CHOLMOD's factor-and-solve per mode and ordering, the fastest in bold, and the solver's pick."""
-    lines = ["| unknowns | mesh | simplicial: " + " / ".join(ORDERINGS) + " [ms] | supernodal: " + " / ".join(ORDERINGS)
+    lines = on_host(rows) + ["| unknowns | mesh | simplicial: " + " / ".join(ORDERINGS) + " [ms] | supernodal: " + " / ".join(ORDERINGS)
              + " [ms] | the solver's | its time / the fastest |", "|---|---|---|---|---|---|"]
     cases = {}
     for r in rows:
@@ -636,7 +642,7 @@ def seepage_orderings(rows):
 @block("seepage linear solvers", "seepage_fe/benchmark/crossover.csv")
 def seepage_linear_solvers(rows):
     """Per Newton iteration: CHOLMOD against conjugate gradients (incomplete Cholesky, and an earlier factor)."""
-    lines = ["| unknowns | mesh | time step | direct [s] | cg [s] | lagged [s] | cg iterations per Newton iteration: "
+    lines = on_host(rows) + ["| unknowns | mesh | time step | direct [s] | cg [s] | lagged [s] | cg iterations per Newton iteration: "
              "cg / lagged | cg / direct | lagged / direct |",
              "|---|---|---|---|---|---|---|---|---|"]
     cases = {}
@@ -666,7 +672,7 @@ def seepage_linear_solvers_3d(rows):
 @block("seepage against fenicsx", "seepage_fe/benchmark/fenicsx.csv")
 def seepage_against_fenicsx(rows):
     """Per Newton iteration, ours under each linear solver and FEniCSx's, and how far each answer lies from ours, direct."""
-    lines = ["| unknowns | contender | per Newton iteration [s] | Newton iterations per step | FEniCSx's best / this | "
+    lines = on_host(rows) + ["| unknowns | contender | per Newton iteration [s] | Newton iterations per step | FEniCSx's best / this | "
              "max abs(u - u_direct) / max abs(u_direct) |",
              "|---|---|---|---|---|---|"]
     for r in sorted(rows, key=lambda r: int(r["unknowns"])):

@@ -23,6 +23,7 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include "common/host.hpp"
 #include "mpm_solid/materials/drucker_prager.hpp"
 #include "mpm_solid/materials/elastic.hpp"
 #include "mpm_solid/materials/elastic_damage.hpp"
@@ -214,10 +215,12 @@ int main(int argc, char** argv) {
       return 2;
     }
     std::fprintf(csv, "particles,shape,material,one_thread,two_threads,speed_up,bytes_per_particle,"
-                      "grid_bytes_per_particle\n");
+                      "grid_bytes_per_particle,host\n");
   }
-  std::printf("particle-steps per second (%s), %d cores\n\n",
-              dimension == 2 ? "2D plane strain, 4 particles per cell" : "3D, 8 particles per cell", cores);
+  const std::string host = host_description();
+  std::printf("particle-steps per second (%s), %d cores, on %s\n\n",
+              dimension == 2 ? "2D plane strain, 4 particles per cell" : "3D, 8 particles per cell", cores,
+              host.c_str());
   // Memory per particle: the particles' own fields and per-step arrays, and
   // the grid's nodal arrays (with the last thread count's buffers) shared out over them.
   std::printf("%9s %-9s %-15s", "particles", "shape", "material");
@@ -240,10 +243,10 @@ int main(int argc, char** argv) {
         std::fflush(stdout);
         // The CSV keeps its two columns (one and two threads) for the README's table.
         if (csv)
-          std::fprintf(csv, "%ld,%s,%s,%.4e,%.4e,%.3f,%.0f,%.0f\n", n, shape_name(shape), model_name(model),
+          std::fprintf(csv, "%ld,%s,%s,%.4e,%.4e,%.3f,%.0f,%.0f,%s\n", n, shape_name(shape), model_name(model),
                        rows.front().particle_steps_per_second, last.particle_steps_per_second, speed_up,
                        static_cast<double>(last.memory.particles) / count,
-                       static_cast<double>(last.memory.grid) / count);
+                       static_cast<double>(last.memory.grid) / count, host_csv_field().c_str());
       }
   if (csv && std::fclose(csv) != 0) {
     std::fprintf(stderr, "mpm-benchmark: the CSV could not be written in full\n");

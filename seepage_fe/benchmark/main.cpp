@@ -22,6 +22,7 @@
 #include <fmt/format.h>
 
 #include "common/blas.hpp"
+#include "common/host.hpp"
 #include "seepage_fe/solver.hpp"
 
 using namespace outburst;
@@ -160,11 +161,12 @@ void newton_rows(const CaseOf<Dim>& c, const std::vector<std::string>& linear_so
                 cg_iterations, k.best_per_iteration / direct, k.difference);
     std::fflush(stdout);
     if (csv)
-      std::fprintf(csv, "%ld,%s,%g,%d,%s,%s,%g,%.0f,%.6g,%.6g,%.6g,%.6g,%.1f,%.4f,%.3g\n", unknowns, c.mesh_name.c_str(),
-                   dt, steps, k.linear_solver.c_str(), method.c_str(), kind == seepage::LinearSolver::direct ? 0.0 : cg_tolerance, its,
+      std::fprintf(csv, "%ld,%s,%g,%d,%s,%s,%g,%.0f,%.6g,%.6g,%.6g,%.6g,%.1f,%.4f,%.3g,%s\n", unknowns,
+                   c.mesh_name.c_str(), dt, steps, k.linear_solver.c_str(), method.c_str(),
+                   kind == seepage::LinearSolver::direct ? 0.0 : cg_tolerance, its,
                    k.best_per_iteration, t.factorization / its, t.solve / its,
                    (t.total_step - t.factorization - t.solve) / its, cg_iterations, k.best_per_iteration / direct,
-                   k.difference);
+                   k.difference, host_csv_field().c_str());
     if (csv) std::fflush(csv);  // a stopped run keeps its rows
   }
 }
@@ -223,9 +225,10 @@ void ordering_rows(const CaseOf<Dim>& c, double dt, long simplicial_up_to, int r
                 name.c_str(), v.analyse_s, v.best, v.factor_nonzeros, v.flops, v.best / fastest,
                 name == chosen ? "  <- the solver's" : "");
     if (csv)
-      std::fprintf(csv, "%ld,%s,%s,%s,%.6g,%.6g,%.6g,%.6g,%.4f,%d\n", unknowns, c.mesh_name.c_str(),
+      std::fprintf(csv, "%ld,%s,%s,%s,%.6g,%.6g,%.6g,%.6g,%.4f,%d,%s\n", unknowns, c.mesh_name.c_str(),
                    name.substr(0, name.find('/')).c_str(), name.substr(name.find('/') + 1).c_str(), v.analyse_s,
-                   v.best, v.factor_nonzeros, v.flops, v.best / fastest, name == chosen ? 1 : 0);
+                   v.best, v.factor_nonzeros, v.flops, v.best / fastest, name == chosen ? 1 : 0,
+                   host_csv_field().c_str());
     if (csv) std::fflush(csv);
   }
   std::fflush(stdout);
@@ -294,16 +297,17 @@ int main(int argc, char** argv) {
   try {
     std::FILE* csv = open_csv(csv_path, "unknowns,mesh,time_step_s,steps,linear_solver,method,cg_tolerance,"
                                         "newton_iterations,newton_iteration_s,factor_s,solve_s,other_s,"
-                                        "cg_iterations,over_reference,difference");
+                                        "cg_iterations,over_reference,difference,host");
     std::FILE* orderings = open_csv(orderings_path, "unknowns,mesh,mode,ordering,analyse_s,factor_solve_s,"
-                                                    "factor_nonzeros,flops,over_fastest,chosen");
+                                                    "factor_nonzeros,flops,over_fastest,chosen,host");
     if (sides.empty() && meshes.empty() && cube_sides.empty()) sides = {99, 315, 999};
     std::vector<Case> cases;
     for (int n : sides) cases.push_back(square(n));
     for (const auto& m : meshes) cases.push_back(gmsh(m));
     std::vector<CaseOf<3>> cubes;
     for (int n : cube_sides) cubes.push_back(cube(n));
-    std::printf("BLAS: %s; %d rounds, best kept\n", blas::description().c_str(), rounds);
+    std::printf("On %s; BLAS: %s; %d rounds, best kept\n", host_description().c_str(), blas::description().c_str(),
+                rounds);
     if (!no_newton) {
       std::printf("\nPer Newton iteration [s] (other: residuals, Jacobian values, line search, bookkeeping; differs: max |u - u_first| / max |u_first| after the round)\n");
       std::printf("%9s %-14s %7s %-15s %-24s %7s %10s %9s %9s %9s %8s %8s %9s\n", "unknowns", "mesh", "dt", "solver",
