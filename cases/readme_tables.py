@@ -592,6 +592,12 @@ def mpm_benchmark_avx2(rows):
     return mpm_benchmark(rows)
 
 
+@block("mpm benchmark avx2 screen", "mpm_solid/benchmark/mpm-benchmark-avx2-screen.csv")
+def mpm_benchmark_avx2_screen(rows):
+    """The same after the plastic rows' yield check over lanes, naming the processor."""
+    return mpm_benchmark(rows)
+
+
 @block("mpm benchmark 3d", "mpm_solid/benchmark/mpm-benchmark-3d.csv", "mpm_solid/benchmark/mpm-benchmark.csv")
 def mpm_benchmark_3d(rows, plane):
     """The 3D rows, and what a 3D particle-step costs against a plane one (one thread)."""
