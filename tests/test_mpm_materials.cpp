@@ -120,6 +120,26 @@ TEST_CASE("Drucker-Prager below the yield surface is elastic", "[mpm][material]"
   CHECK(a.plastic_strain[0] == 0);
 }
 
+namespace {
+
+// n velocity gradients [1/s], each particle's own: principal stretch rates of
+// eight amplitudes (0.05 to 0.93 per second along each direction), turned
+// by the particle's own angle, and a spin.
+std::vector<Mat<2>> own_paths(int n) {
+  std::vector<Mat<2>> l(n);
+  for (int k = 0; k < n; ++k) {
+    const double size = 0.05 + (k % 8) / 8.0, angle = 0.7 * k;
+    const double a = size * std::sin(1.3 * k), b = size * std::cos(2.1 * k), spin = 0.2 * std::sin(0.5 * k);
+    Mat<2> r;
+    r << std::cos(angle), -std::sin(angle), std::sin(angle), std::cos(angle);
+    l[k] = r * Vec<2>(a, b).asDiagonal() * r.transpose();
+    l[k](0, 1) -= spin, l[k](1, 0) += spin;
+  }
+  return l;
+}
+
+}  // namespace
+
 TEST_CASE("Drucker-Prager: a chunk screened over SIMD lanes ends as each particle's trial returned alone",
           "[mpm][material]") {
   // A chunk and a few more particles along their own strain paths: elastic,
@@ -144,15 +164,7 @@ TEST_CASE("Drucker-Prager: a chunk screened over SIMD lanes ends as each particl
   for (int k = 0; k < n; ++k) (k % 2 ? odds : evens).push_back(k);
   m.create_fields(together, members);
   together.need_velocity_gradients();
-  std::vector<Mat<2>> l(n);
-  for (int k = 0; k < n; ++k) {
-    const double size = 0.05 + (k % 8) / 8.0, angle = 0.7 * k;
-    const double a = size * std::sin(1.3 * k), b = size * std::cos(2.1 * k), spin = 0.2 * std::sin(0.5 * k);
-    Mat<2> r;
-    r << std::cos(angle), -std::sin(angle), std::sin(angle), std::cos(angle);
-    l[k] = r * Vec<2>(a, b).asDiagonal() * r.transpose();
-    l[k](0, 1) -= spin, l[k](1, 0) += spin;
-  }
+  std::vector<Mat<2>> l = own_paths(n);
   l[0].setZero();               // never loaded
   l[1] = Mat<2>::Identity();    // spreading: past the apex
   l[2] = -Mat<2>::Identity();   // squeezed equally: no shear, elastic
@@ -478,16 +490,8 @@ TEST_CASE("elastic-damage: a chunk settled over SIMD lanes ends as each of its p
     std::iota(members.begin(), members.end(), 0);
     m.create_fields(together, members);
     together.need_velocity_gradients();
-    std::vector<Mat<2>> l(n);
-    for (int k = 0; k < n; ++k) {
-      // Eight amplitudes: strains from 2e-5 to 3.5e-4 along each direction.
-      const double size = 0.05 + (k % 8) / 8.0, angle = 0.7 * k;
-      const double a = size * std::sin(1.3 * k), b = size * std::cos(2.1 * k), spin = 0.2 * std::sin(0.5 * k);
-      Mat<2> r;
-      r << std::cos(angle), -std::sin(angle), std::sin(angle), std::cos(angle);
-      l[k] = r * Vec<2>(a, b).asDiagonal() * r.transpose();
-      l[k](0, 1) -= spin, l[k](1, 0) += spin;
-    }
+    // Eight amplitudes: strains from 2e-5 to 3.5e-4 along each direction.
+    std::vector<Mat<2>> l = own_paths(n);
     l[0].setZero();                // never loaded: principal values equal
     l[1] = Mat<2>::Identity();     // spreading equally: in tension, no axes
     l[2] = -Mat<2>::Identity();    // squeezed equally
