@@ -47,7 +47,7 @@ Dissipation DruckerPrager<Dim>::update_chunk(Particles<Dim>& p, std::span<const 
     double& zz = out_of_plane<Dim>(p.stress_zz, i, none);
     double work = 0;
     p.plastic_strain[i] += per_multiplier * return_map(p.stress[i], zz, &work);
-    return Dissipation{p.volume[i] * work, 0};
+    return work == 0 ? Dissipation{} : Dissipation{p.volume[i] * work, 0};
   };
   if constexpr (Dim == 2) {
     // In pieces of chunk_size, the screen's length. A particle the screen
@@ -58,8 +58,8 @@ Dissipation DruckerPrager<Dim>::update_chunk(Particles<Dim>& p, std::span<const 
       const auto part = members.subspan(first, std::min<std::size_t>(chunk_size, members.size() - first));
       double outside[chunk_size];
       by_position(part, [&](auto index) { screen_plane(p, static_cast<int>(part.size()), index, outside); });
-      for (std::size_t k = 0; k < part.size(); ++k)
-        if (outside[k] != 0) total += return_one(part[k]);
+      for (std::size_t j = 0; j < part.size(); ++j)
+        if (outside[j] != 0) total += return_one(part[j]);
     }
     return total;
   } else {
@@ -69,14 +69,17 @@ Dissipation DruckerPrager<Dim>::update_chunk(Particles<Dim>& p, std::span<const 
 
 // Most particles, most steps, lie inside the cone, and return_map found so
 // one at a time through a division and a square root: a seventh of a linear
-// Drucker-Prager step on a processor whose vectors hold two doubles
-// (README.md, "The same builds on another processor"). Lanes decide the same
-// for a chunk with neither: f <= 0 is sqrt(J2) <= r = k - alpha mean, so J2
-// <= r^2 for r >= 0. The lanes' mean (a product by 1/3, not a division) and
-// sums differ from return_map's by a few ulps of the largest stress entry
-// S; a margin of 1e-12 (S + k) on r, hundreds of times those, leaves every
-// particle it cannot clear, NaN included, to return_map, which decides
-// again as before. So the screen moves no result.
+// Drucker-Prager step under GCC's Zen 1 tuning, which vectorises two doubles
+// at a time (README.md, "The same builds on another processor"). Lanes
+// decide the same for a chunk with neither: f <= 0 is sqrt(J2) <= r = k -
+// alpha mean, so J2 <= r^2 for r >= 0. The lanes' mean (a product by 1/3,
+// not a division) and sums differ from return_map's by tens of ulps of S (1
+// + alpha) + k, S the largest stress entry; a margin of 1e-12 (S + |k|) on
+// r, thousands of ulps, leaves every particle it cannot clear to
+// return_map, which decides again as before. So does a reach below 2^-450
+// or above 2^450, whose square would leave the normal numbers (a subnormal
+// square rounds coarser than the margin; an infinite one passes an infinite
+// J2), and NaN. So the screen moves no result.
 template <int Dim>
 template <class Index>
 void DruckerPrager<Dim>::screen_plane(const Particles<Dim>& p, int n, Index index, double* outside) const {
@@ -98,8 +101,9 @@ void DruckerPrager<Dim>::screen_plane(const Particles<Dim>& p, int n, Index inde
     const auto wider = [](double a, double b) { return a < b ? b : a; };
     const double largest =
         wider(wider(wider(std::abs(s0), std::abs(s1)), wider(std::abs(s2), std::abs(s3))), std::abs(zz));
-    const double reach = k - alpha * mean - 1e-12 * (largest + k);
-    outside[m] = reach > 0 ? (j2 <= reach * reach ? 0.0 : 1.0) : 1.0;
+    const double reach = k - alpha * mean - 1e-12 * (largest + std::abs(k));
+    const double normal = reach > 0x1p-450 ? (reach < 0x1p+450 ? 1.0 : 0.0) : 0.0;
+    outside[m] = normal != 0 ? (j2 <= reach * reach ? 0.0 : 1.0) : 1.0;
   }
 }
 
