@@ -38,9 +38,7 @@ std::map<std::string, std::string> first_processor() {
   return fields;
 }
 
-}  // namespace
-
-std::string host_description() {
+std::string describe() {
   const auto fields = first_processor();
   const auto field = [&](const char* key) {
     const auto it = fields.find(key);
@@ -51,9 +49,10 @@ std::string host_description() {
     utsname system{};
     model = uname(&system) == 0 ? system.machine : "unknown processor";
   }
-  if (!field("cpu family").empty() && !field("model").empty())
+  // As builds.py's host(): present keys count, empty or not.
+  if (fields.count("cpu family") && fields.count("model"))
     model += fmt::format(" (family {}, model {})", field("cpu family"), field("model"));
-  std::istringstream flag_words(field("flags").empty() ? field("Features") : field("flags"));
+  std::istringstream flag_words(fields.count("flags") ? field("flags") : field("Features"));
   std::vector<std::string> flags{std::istream_iterator<std::string>(flag_words), {}};
   std::string vectors = "vector extensions unknown";
   for (const auto& [flag, name] : std::vector<std::pair<std::string, std::string>>{
@@ -68,6 +67,14 @@ std::string host_description() {
                        ? CPU_COUNT(&allowed)
                        : static_cast<int>(std::thread::hardware_concurrency());
   return fmt::format("{}, {}, {} CPUs", model, vectors, cpus);
+}
+
+}  // namespace
+
+// Read once: a benchmark names it in every row of its CSVs.
+std::string host_description() {
+  static const std::string description = describe();
+  return description;
 }
 
 std::string host_csv_field() {

@@ -13,7 +13,7 @@ namespace outburst {
 // the logical CPUs this process may use, e.g. "AMD EPYC (family 23, model 1),
 // AVX2, 2 CPUs". scripts/builds.py's host() gives the same words to the
 // comparison scripts, so that cases/readme_tables.py names the host above a
-// table from either.
+// table from either. Taken at the first call.
 std::string host_description();
 
 // The same as one CSV field (quoted: it holds commas).
