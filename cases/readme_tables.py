@@ -627,8 +627,9 @@ ORDERINGS = ["amd", "metis", "nesdis", "cholmod_default"]
 @block("seepage orderings", "seepage_fe/benchmark/orderings.csv")
 def seepage_orderings(rows):
     """CHOLMOD's factor-and-solve per mode and ordering, the fastest in bold, and the solver's pick."""
-    lines = on_host(rows) + ["| unknowns | mesh | simplicial: " + " / ".join(ORDERINGS) + " [ms] | supernodal: " + " / ".join(ORDERINGS)
-             + " [ms] | the solver's | its time / the fastest |", "|---|---|---|---|---|---|"]
+    lines = on_host(rows) + [
+        "| unknowns | mesh | simplicial: " + " / ".join(ORDERINGS) + " [ms] | supernodal: " + " / ".join(ORDERINGS)
+        + " [ms] | the solver's | its time / the fastest |", "|---|---|---|---|---|---|"]
     cases = {}
     for r in rows:
         cases.setdefault((int(r["unknowns"]), r["mesh"]), {})[(r["mode"], r["ordering"])] = r
@@ -648,9 +649,10 @@ def seepage_orderings(rows):
 @block("seepage linear solvers", "seepage_fe/benchmark/crossover.csv")
 def seepage_linear_solvers(rows):
     """Per Newton iteration: CHOLMOD against conjugate gradients (incomplete Cholesky, and an earlier factor)."""
-    lines = on_host(rows) + ["| unknowns | mesh | time step | direct [s] | cg [s] | lagged [s] | cg iterations per Newton iteration: "
-             "cg / lagged | cg / direct | lagged / direct |",
-             "|---|---|---|---|---|---|---|---|---|"]
+    lines = on_host(rows) + [
+        "| unknowns | mesh | time step | direct [s] | cg [s] | lagged [s] | cg iterations per Newton iteration: "
+        "cg / lagged | cg / direct | lagged / direct |",
+        "|---|---|---|---|---|---|---|---|---|"]
     cases = {}
     for r in rows:
         cases.setdefault((r["mesh"], float(r["time_step_s"]), int(r["unknowns"])), {})[r["linear_solver"]] = r
@@ -678,9 +680,10 @@ def seepage_linear_solvers_3d(rows):
 @block("seepage against fenicsx", "seepage_fe/benchmark/fenicsx.csv")
 def seepage_against_fenicsx(rows):
     """Per Newton iteration, ours under each linear solver and FEniCSx's, and how far each answer lies from ours, direct."""
-    lines = on_host(rows) + ["| unknowns | contender | per Newton iteration [s] | Newton iterations per step | FEniCSx's best / this | "
-             "max abs(u - u_direct) / max abs(u_direct) |",
-             "|---|---|---|---|---|---|"]
+    lines = on_host(rows) + [
+        "| unknowns | contender | per Newton iteration [s] | Newton iterations per step | FEniCSx's best / this | "
+        "max abs(u - u_direct) / max abs(u_direct) |",
+        "|---|---|---|---|---|---|"]
     for r in sorted(rows, key=lambda r: int(r["unknowns"])):
         difference = f"{float(r['difference']):.1e}" if r["difference"] else ""
         lines.append(f"| {r['unknowns']} | {r['contender']} | {float(r['newton_iteration_s']):.3g} | "
