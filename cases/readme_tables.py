@@ -516,6 +516,7 @@ for name, written in [
     ("mpm benchmark a48b78f avx2", "compare-63e0ffd-a48b78f-epyc.csv"),
     ("mpm benchmark settle avx2", "compare-a48b78f-settle-avx2.csv"),
     ("mpm benchmark dp screen avx2", "compare-3b3d886-dp-screen.csv"),
+    ("mpm benchmark dp screen bounded avx2", "compare-3b3d886-dp-screen-bounded.csv"),
     ("mpm benchmark screen avx2", "compare-63e0ffd-screen-epyc.csv"),
 ]:
     block(name, "mpm_solid/benchmark/" + written)(mpm_benchmark_builds)
