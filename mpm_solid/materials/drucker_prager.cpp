@@ -28,11 +28,6 @@ double DruckerPrager<Dim>::return_map(Mat<Dim>& s, double& s_zz, double* work_de
                                     work_density);
 }
 
-template <int Dim>
-double DruckerPrager<Dim>::strain_per_multiplier() const {
-  return std::sqrt(2.0 / 3.0 * (0.5 + alpha_dilation_ * alpha_dilation_ / 3));
-}
-
 // A return that reaches the apex from a purely hydrostatic trial has a zero
 // multiplier and still does plastic work (the mean stress drops to k /
 // alpha): the work is counted wherever the trial lies outside the cone.
@@ -41,7 +36,8 @@ Dissipation DruckerPrager<Dim>::update_chunk(Particles<Dim>& p, std::span<const 
                                              const double* gradients) const {
   deform_and_trial(p, members, dt, this->lame_lambda(), this->shear_modulus(), nullptr, p.stress, p.stress_zz,
                    gradients);
-  const double per_multiplier = strain_per_multiplier();
+  // Equivalent plastic strain per unit multiplier: sqrt(2/3 |dg/dsigma|^2).
+  const double per_multiplier = std::sqrt(2.0 / 3.0 * (0.5 + alpha_dilation_ * alpha_dilation_ / 3));
   const auto return_one = [&](int i) {
     double none = 0;
     double& zz = out_of_plane<Dim>(p.stress_zz, i, none);

@@ -30,8 +30,6 @@ class DruckerPrager final : public Material<Dim> {
   // inside the cone, 1 for one that may not.
   template <class Index>
   void screen_plane(const Particles<Dim>& p, int n, Index index, double* outside) const;
-  // Equivalent plastic strain per unit multiplier: sqrt(2/3 |dg/dsigma|^2).
-  double strain_per_multiplier() const;
 
   double alpha_, k_, alpha_dilation_;
 };
