@@ -587,16 +587,11 @@ def mpm_benchmark(rows):
     return lines
 
 
-@block("mpm benchmark avx2", "mpm_solid/benchmark/mpm-benchmark-avx2.csv")
-def mpm_benchmark_avx2(rows):
-    """mpm-benchmark's own CSV from the AVX2 processor of "The same builds on another processor"."""
-    return mpm_benchmark(rows)
-
-
-@block("mpm benchmark avx2 screen", "mpm_solid/benchmark/mpm-benchmark-avx2-screen.csv")
-def mpm_benchmark_avx2_screen(rows):
-    """The same after the plastic rows' yield check over lanes, naming the processor."""
-    return mpm_benchmark(rows)
+# mpm-benchmark's own CSVs from the AVX2 processor of "The same builds on another processor": before and
+# after the plastic rows' yield check over lanes.
+for name, written in [("mpm benchmark avx2", "mpm-benchmark-avx2.csv"),
+                      ("mpm benchmark avx2 screen", "mpm-benchmark-avx2-screen.csv")]:
+    block(name, "mpm_solid/benchmark/" + written)(mpm_benchmark)
 
 
 @block("mpm benchmark 3d", "mpm_solid/benchmark/mpm-benchmark-3d.csv", "mpm_solid/benchmark/mpm-benchmark.csv")
