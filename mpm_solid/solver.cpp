@@ -6,6 +6,7 @@
 #include <cassert>
 #include <numeric>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <type_traits>
 
@@ -83,6 +84,27 @@ constexpr bool lean_build = true;
 constexpr bool lean_build = false;
 #endif
 
+// Whether the gathers in the plane take a node's velocity as one vector of
+// its two components, a particle at a time, rather than a component of
+// several particles' nodes, one lane each, loaded lane by lane (CMake's
+// OUTBURST_GATHER: where vectors hold two doubles, pairs load half as often;
+// README.md, "The same builds on another processor"). Each component's sums
+// run over the nodes in the same order with the same products either way.
+#ifdef OUTBURST_GATHER_PAIRS
+constexpr bool gather_pairs = true;
+#else
+constexpr bool gather_pairs = false;
+#endif
+
+// GCC's vector extensions: a node's two components; load_pair reads them
+// where a Vec<2> may lie.
+using Pair = double __attribute__((vector_size(16)));
+[[gnu::always_inline]] inline Pair load_pair(const double* at) {
+  Pair v;
+  std::memcpy(&v, at, sizeof v);
+  return v;
+}
+
 // The helpers below run inside the particle loops (once per particle, or per
 // chunk of them), and are forced inline: called, each returned or took its
 // matrices through memory, and the loop stalled reloading them whole from
@@ -110,6 +132,20 @@ template <int Dim, class Shape, int Width>
                                                       const StencilLanes<Dim, Shape, Width>& s, int lanes,
                                                       double (&out)[Dim][Dim][Width]) {
   const double* nodal = velocity.data()->data();
+  if constexpr (Dim == 2 && gather_pairs) {
+    for (int lane = 0; lane < lanes; ++lane) {
+      const double* v = nodal + 2 * s.first[lane];
+      Pair l[2] = {};
+      s.for_each_node([&](int k, const std::array<int, Dim>& a) __attribute__((always_inline)) {
+        const Pair at = load_pair(v + 2 * s.offset[k]);
+        l[0] += at * s.gradient(0, a, lane);
+        l[1] += at * s.gradient(1, a, lane);
+      });
+      for (int d = 0; d < 2; ++d)
+        for (int b = 0; b < 2; ++b) out[d][b][lane] = l[d][b];
+    }
+    return;
+  }
   // Summed in a local: in `out` the sums were loaded and stored again at
   // every node, as the nodal velocities might alias it.
   alignas(64) double l[Dim][Dim][Width] = {};
@@ -1251,23 +1287,46 @@ void Solver<Dim>::gather_motion(double dt) {
       }
       over_chunks(s, p, [&](int start, int lanes) __attribute__((always_inline)) {
         alignas(64) double v_pic[Dim][Lanes::width] = {}, dv[Dim][Lanes::width] = {}, spread[Lanes::width] = {};
-        Lanes::for_each_node([&](int k, const std::array<int, Dim>& a) {
-          const std::ptrdiff_t offset = s.offset[k];
-#pragma omp simd
+        if constexpr (Dim == 2 && gather_pairs) {
           for (int lane = 0; lane < lanes; ++lane) {
-            const double weight = s.weight(a, lane);
-            const double *v = now + Dim * (s.first[lane] + offset), *v_new = next + Dim * (s.first[lane] + offset);
-            double squared = 0;
-#pragma GCC unroll 3
-            for (int e = 0; e < Dim; ++e) {
-              const double change = v_new[e] - v[e];
-              v_pic[e][lane] += weight * v_new[e];
-              dv[e][lane] += weight * change;
-              squared += change * change;
+            const double *v = now + 2 * s.first[lane], *v_new = next + 2 * s.first[lane];
+            Pair pic = {}, change_sum = {};
+            double spread_sum = 0;
+            Lanes::for_each_node([&](int k, const std::array<int, Dim>& a) __attribute__((always_inline)) {
+              const double weight = s.weight(a, lane);
+              const Pair at_new = load_pair(v_new + 2 * s.offset[k]), change = at_new - load_pair(v + 2 * s.offset[k]);
+              pic += weight * at_new;
+              change_sum += weight * change;
+              // Summed as the lanes sum it, for the same bits.
+              double squared = change[0] * change[0];
+              squared += change[1] * change[1];
+              spread_sum += weight * squared;
+            });
+            for (int e = 0; e < 2; ++e) {
+              v_pic[e][lane] = pic[e];
+              dv[e][lane] = change_sum[e];
             }
-            spread[lane] += weight * squared;
+            spread[lane] = spread_sum;
           }
-        });
+        } else {
+          Lanes::for_each_node([&](int k, const std::array<int, Dim>& a) {
+            const std::ptrdiff_t offset = s.offset[k];
+#pragma omp simd
+            for (int lane = 0; lane < lanes; ++lane) {
+              const double weight = s.weight(a, lane);
+              const double *v = now + Dim * (s.first[lane] + offset), *v_new = next + Dim * (s.first[lane] + offset);
+              double squared = 0;
+#pragma GCC unroll 3
+              for (int e = 0; e < Dim; ++e) {
+                const double change = v_new[e] - v[e];
+                v_pic[e][lane] += weight * v_new[e];
+                dv[e][lane] += weight * change;
+                squared += change * change;
+              }
+              spread[lane] += weight * squared;
+            }
+          });
+        }
         const long troubled = census.bad + census.runaway;
         finish(start, lanes, v_pic, dv, spread, nullptr, census, lost, work, gained);
         if constexpr (Move) {
