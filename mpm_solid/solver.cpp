@@ -6,13 +6,13 @@
 #include <cassert>
 #include <numeric>
 #include <cmath>
-#include <cstring>
 #include <limits>
 #include <type_traits>
 
 #include <fmt/format.h>
 
 #include "common/interval.hpp"
+#include "mpm_solid/gathers.hpp"
 #include "mpm_solid/shape.hpp"
 #include "mpm_solid/stencil.hpp"
 
@@ -84,26 +84,13 @@ constexpr bool lean_build = true;
 constexpr bool lean_build = false;
 #endif
 
-// Whether the gathers in the plane take a node's velocity as one vector of
-// its two components, a particle at a time, rather than a component of
-// several particles' nodes, one lane each, loaded lane by lane (CMake's
-// OUTBURST_GATHER: where vectors hold two doubles, pairs load half as often;
-// README.md, "The same builds on another processor"). Each component's sums
-// run over the nodes in the same order with the same products either way.
+// Which form the gathers' node loops take (mpm_solid/gathers.hpp; CMake's
+// OUTBURST_GATHER picks it for the build).
 #ifdef OUTBURST_GATHER_PAIRS
 constexpr bool gather_pairs = true;
 #else
 constexpr bool gather_pairs = false;
 #endif
-
-// GCC's vector extensions: a node's two components; load_pair reads them
-// where a Vec<2> may lie.
-using Pair = double __attribute__((vector_size(16)));
-[[gnu::always_inline]] inline Pair load_pair(const double* at) {
-  Pair v;
-  std::memcpy(&v, at, sizeof v);
-  return v;
-}
 
 // The helpers below run inside the particle loops (once per particle, or per
 // chunk of them), and are forced inline: called, each returned or took its
@@ -122,47 +109,6 @@ template <int Dim, class Shape, int Width, class F>
     s.compute(p.x.data(), p.half_width.data(), [start](int lane) { return start + lane; }, lanes);
     f(start, lanes);
   }
-}
-
-// L = grad v from the grid's velocities at the particles of a chunk's
-// lanes: d v_b / d x_d of lane `lane` at l[d][b][lane], each lane's entries
-// in Eigen's order (entry e = b + Dim d at l[0][0] + e * Width).
-template <int Dim, class Shape, int Width>
-[[gnu::always_inline]] inline void velocity_gradients(const std::vector<Vec<Dim>>& velocity,
-                                                      const StencilLanes<Dim, Shape, Width>& s, int lanes,
-                                                      double (&out)[Dim][Dim][Width]) {
-  const double* nodal = velocity.data()->data();
-  if constexpr (Dim == 2 && gather_pairs) {
-    for (int lane = 0; lane < lanes; ++lane) {
-      const double* v = nodal + 2 * s.first[lane];
-      Pair l[2] = {};
-      s.for_each_node([&](int k, const std::array<int, Dim>& a) __attribute__((always_inline)) {
-        const Pair at = load_pair(v + 2 * s.offset[k]);
-        l[0] += at * s.gradient(0, a, lane);
-        l[1] += at * s.gradient(1, a, lane);
-      });
-      for (int d = 0; d < 2; ++d)
-        for (int b = 0; b < 2; ++b) out[d][b][lane] = l[d][b];
-    }
-    return;
-  }
-  // Summed in a local: in `out` the sums were loaded and stored again at
-  // every node, as the nodal velocities might alias it.
-  alignas(64) double l[Dim][Dim][Width] = {};
-  s.for_each_node([&](int k, const std::array<int, Dim>& a) {
-    const std::ptrdiff_t offset = s.offset[k];
-#pragma omp simd
-    for (int lane = 0; lane < lanes; ++lane) {
-      const double* v = nodal + Dim * (s.first[lane] + offset);
-#pragma GCC unroll 3
-      for (int d = 0; d < Dim; ++d) {
-        const double g = s.gradient(d, a, lane);
-#pragma GCC unroll 3
-        for (int b = 0; b < Dim; ++b) l[d][b][lane] += v[b] * g;
-      }
-    }
-  });
-  std::copy_n(&l[0][0][0], Dim * Dim * Width, &out[0][0][0]);
 }
 
 // Scatters the mass and momentum of particles start .. start + lanes - 1,
@@ -720,7 +666,7 @@ void Solver<Dim>::gather_velocity_gradient() {
     StencilLanes<Dim, Shape> s(lattice);
     over_chunks(s, p, [&](int start, int lanes) {
       alignas(64) double l[Dim][Dim][decltype(s)::width];
-      velocity_gradients(velocity_, s, lanes, l);
+      gathers::velocity_gradients<gather_pairs>(velocity_.data()->data(), s, lanes, l);
       for (int lane = 0; lane < lanes; ++lane) {
         Mat<Dim>& out = p.velocity_gradient[start + lane];
         for (int b = 0; b < Dim; ++b)
@@ -840,7 +786,7 @@ void Solver<Dim>::update_and_scatter(double dt) {
         by_position(chunk, [&](auto particle) __attribute__((always_inline)) {
           s.compute(p.x.data(), p.half_width.data(), particle, lanes);
           alignas(64) double l[Dim][Dim][chunk_size];
-          velocity_gradients(velocity_, s, lanes, l);
+          gathers::velocity_gradients<gather_pairs>(velocity_.data()->data(), s, lanes, l);
           const Dissipation d = materials_[m]->update_chunk(p, chunk, dt, &l[0][0][0]);
           plastic += d.plastic;
           damage += d.damage;
@@ -1286,47 +1232,8 @@ void Solver<Dim>::gather_motion(double dt) {
         reached = active_.marks(omp_get_thread_num());
       }
       over_chunks(s, p, [&](int start, int lanes) __attribute__((always_inline)) {
-        alignas(64) double v_pic[Dim][Lanes::width] = {}, dv[Dim][Lanes::width] = {}, spread[Lanes::width] = {};
-        if constexpr (Dim == 2 && gather_pairs) {
-          for (int lane = 0; lane < lanes; ++lane) {
-            const double *v = now + 2 * s.first[lane], *v_new = next + 2 * s.first[lane];
-            Pair pic = {}, change_sum = {};
-            double spread_sum = 0;
-            Lanes::for_each_node([&](int k, const std::array<int, Dim>& a) __attribute__((always_inline)) {
-              const double weight = s.weight(a, lane);
-              const Pair at_new = load_pair(v_new + 2 * s.offset[k]), change = at_new - load_pair(v + 2 * s.offset[k]);
-              pic += weight * at_new;
-              change_sum += weight * change;
-              // Summed as the lanes sum it, for the same bits.
-              double squared = change[0] * change[0];
-              squared += change[1] * change[1];
-              spread_sum += weight * squared;
-            });
-            for (int e = 0; e < 2; ++e) {
-              v_pic[e][lane] = pic[e];
-              dv[e][lane] = change_sum[e];
-            }
-            spread[lane] = spread_sum;
-          }
-        } else {
-          Lanes::for_each_node([&](int k, const std::array<int, Dim>& a) {
-            const std::ptrdiff_t offset = s.offset[k];
-#pragma omp simd
-            for (int lane = 0; lane < lanes; ++lane) {
-              const double weight = s.weight(a, lane);
-              const double *v = now + Dim * (s.first[lane] + offset), *v_new = next + Dim * (s.first[lane] + offset);
-              double squared = 0;
-#pragma GCC unroll 3
-              for (int e = 0; e < Dim; ++e) {
-                const double change = v_new[e] - v[e];
-                v_pic[e][lane] += weight * v_new[e];
-                dv[e][lane] += weight * change;
-                squared += change * change;
-              }
-              spread[lane] += weight * squared;
-            }
-          });
-        }
+        alignas(64) double v_pic[Dim][Lanes::width], dv[Dim][Lanes::width], spread[Lanes::width];
+        gathers::motion_sums<gather_pairs>(now, next, s, lanes, v_pic, dv, spread);
         const long troubled = census.bad + census.runaway;
         finish(start, lanes, v_pic, dv, spread, nullptr, census, lost, work, gained);
         if constexpr (Move) {

@@ -2,16 +2,19 @@
 // stencil per particle (Stencil, what APIC and the dilatation remedy use):
 // the same nodes, weights and gradients to the bit, for every shape in 2D
 // and 3D, and the same verdict on a support that leaves the ghost-padded grid;
-// and the runs of lanes the linear stencils scatter as one.
+// the runs of lanes the linear stencils scatter as one; and the gathers' two
+// forms (mpm_solid/gathers.hpp) to the same bits.
 #include <catch2/catch.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstring>
 #include <limits>
 #include <random>
 #include <vector>
 
+#include "mpm_solid/gathers.hpp"
 #include "mpm_solid/shape.hpp"
 #include "mpm_solid/stencil.hpp"
 
@@ -182,4 +185,74 @@ TEST_CASE("run_end: under linear stencils a run is the lanes that follow on one 
   CHECK(run_ends<Linear>() == std::vector<int>{2, 3, 5, 6, 7});
   CHECK(run_ends<Gimp>() == std::vector<int>{1, 2, 3, 4, 5, 6, 7});
   CHECK(run_ends<Bspline>() == std::vector<int>{1, 2, 3, 4, 5, 6, 7});
+}
+
+namespace {
+// Whether `count` entries of each lane-major row agree to the bit.
+template <std::size_t Rows, int Width>
+bool same_bits(const double (&a)[Rows][Width], const double (&b)[Rows][Width], int count) {
+  for (std::size_t r = 0; r < Rows; ++r)
+    if (std::memcmp(a[r], b[r], sizeof(double) * static_cast<std::size_t>(count)) != 0) return false;
+  return true;
+}
+
+template <class Shape>
+void gather_forms_agree() {
+  Grid<2> g;
+  g.h = 0.25;
+  g.lower = Vec<2>(-0.5, 1.0);
+  g.cells = {9, 6};
+  g.upper = Vec<2>(g.lower[0] + 9 * g.h, g.lower[1] + 6 * g.h);
+  const Lattice<2> lattice(g);
+  std::mt19937 rng(7 + Shape::support);
+  // Velocities over six decades and both signs, so that any change in the
+  // order of a sum, or in which products fuse, shows in the last bits.
+  const auto value = [&] {
+    return std::uniform_real_distribution<double>(-1, 1)(rng) *
+           std::pow(10.0, std::uniform_real_distribution<double>(-3, 3)(rng));
+  };
+  std::vector<double> now(2 * static_cast<std::size_t>(lattice.nodes_along[0] * lattice.nodes_along[1])), next(now.size());
+  for (std::size_t i = 0; i < now.size(); ++i) {
+    now[i] = value();
+    next[i] = now[i] + (i % 5 == 0 ? 0.0 : value());  // some nodes unchanged
+  }
+  std::vector<Vec<2>> x(203);
+  std::vector<double> half_width(x.size());
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    for (int d = 0; d < 2; ++d) x[i][d] = std::uniform_real_distribution<double>(g.lower[d], g.upper[d])(rng);
+    half_width[i] = std::uniform_real_distribution<double>(0.1, 0.45)(rng);
+  }
+  constexpr int width = 32;
+  StencilLanes<2, Shape, width> s(lattice);
+  int chunks = 0;
+  for (int start = 0; start < static_cast<int>(x.size()); start += width, ++chunks) {
+    const int lanes = std::min(width, static_cast<int>(x.size()) - start);
+    s.compute(x.data(), half_width.data(), [start](int lane) { return start + lane; }, lanes);
+    for (int lane = 0; lane < lanes; ++lane) REQUIRE(s.inside(lane));
+    INFO(Shape::name << ", chunk from particle " << start << ", " << lanes << " lanes");
+    double l_lanes[2][2][width], l_pairs[2][2][width];
+    gathers::velocity_gradients<false>(now.data(), s, lanes, l_lanes);
+    gathers::velocity_gradients<true>(now.data(), s, lanes, l_pairs);
+    CHECK(same_bits(l_lanes[0], l_pairs[0], lanes));
+    CHECK(same_bits(l_lanes[1], l_pairs[1], lanes));
+    double pic_lanes[2][width], dv_lanes[2][width], spread_lanes[1][width];
+    double pic_pairs[2][width], dv_pairs[2][width], spread_pairs[1][width];
+    gathers::motion_sums<false>(now.data(), next.data(), s, lanes, pic_lanes, dv_lanes, spread_lanes[0]);
+    gathers::motion_sums<true>(now.data(), next.data(), s, lanes, pic_pairs, dv_pairs, spread_pairs[0]);
+    CHECK(same_bits(pic_lanes, pic_pairs, lanes));
+    CHECK(same_bits(dv_lanes, dv_pairs, lanes));
+    CHECK(same_bits(spread_lanes, spread_pairs, lanes));
+    // Not zero: a gather that summed nothing would agree too.
+    CHECK(spread_pairs[0][0] > 0);
+  }
+  CHECK(chunks == 7);  // the last one partial
+}
+}  // namespace
+
+TEST_CASE("the gathers' two forms, a chunk's particles over lanes and a node's velocity as one pair, give the same "
+          "velocity gradients and motion sums to the bit",
+          "[mpm][stencil]") {
+  gather_forms_agree<Linear>();
+  gather_forms_agree<Gimp>();
+  gather_forms_agree<Bspline>();
 }
