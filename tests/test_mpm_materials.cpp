@@ -623,6 +623,52 @@ std::pair<double, double> weibull_fit(std::vector<double>& u, double m) {
   return {ks, (n * sxy - sx * sy) / (n * sxx - sx * sx)};
 }
 
+TEST_CASE("elastic-damage: stresses whose squares fall below the normal numbers keep finite principal axes, over "
+          "lanes and alone",
+          "[mpm][material][damage]") {
+  // A body at rest under gravity carries, far from its corners, shear and
+  // stress differences of 1e-160 and less: the grid's round-off, spread a
+  // cell a step. Their squares are subnormal or zero, and the principal
+  // radius then came out below |half the difference| for some: the
+  // half-angle roots turned NaN, and a benchmark's falling block, built for
+  // plain x86-64, blew up in 52 steps. No velocity gradient: the trial is the
+  // stress itself, too small to damage anything.
+  ElasticDamage<2> m("coal", coal, coal_damage);
+  Particles<2> p;
+  std::vector<Mat<2>> given;
+  for (const double half : {0.0, 1e-170, 3e-162, 1e-160, 7e-158, 1e-155})
+    for (const double shear : {0.0, 1e-175, 1e-170, 3e-163, 1e-160, 1e-155})
+      for (const double sign : {1.0, -1.0}) {
+        Mat<2> s;
+        s << sign * half, shear, shear, -sign * half;
+        given.push_back(s);
+      }
+  for (std::size_t k = 0; k < given.size(); ++k)
+    p.add({0.1 * static_cast<double>(k), 0}, {0, 0}, 1, 1, 0.25, Mat<2>::Zero(), 0, 0);
+  std::vector<int> members(given.size());
+  std::iota(members.begin(), members.end(), 0);
+  m.create_fields(p, members);
+  p.need_velocity_gradients();
+  for (std::size_t k = 0; k < given.size(); ++k) p.effective_stress[k] = p.stress[k] = given[k];
+  Particles<2> alone = p;
+  m.update_stress(p, members, 1e-6);  // a whole chunk and part of one, over lanes
+  for (int k : members) m.update_stress(alone, {k}, 1e-6);
+  // The squares keep too few bits for the decomposition to give back the
+  // stress to its own digits: it must stay finite and as small as it was.
+  int bad = 0;
+  for (int k : members) {
+    CAPTURE(k, given[k](0, 0), given[k](0, 1));
+    const double largest = given[k].cwiseAbs().maxCoeff();
+    for (const Particles<2>* q : {&p, &alone}) {
+      bad += !q->stress[k].allFinite() || !q->effective_stress[k].allFinite();
+      CHECK(q->damage[k] == 0);
+      CHECK(q->stress[k].cwiseAbs().maxCoeff() <= 2 * largest);
+    }
+  }
+  CHECK(bad == 0);
+  CHECK(given.size() > static_cast<std::size_t>(chunk_size));
+}
+
 TEST_CASE("heterogeneous coal: strength and modulus factors follow the Weibull laws of their homogeneity indices, "
           "mean 1, independent of each other and set by the seed alone",
           "[mpm][material][damage][heterogeneity]") {

@@ -43,8 +43,15 @@ struct Principal<2> {
     const double half = 0.5 * (xx - yy);
     const double radius = std::sqrt(half * half + xy * xy);
     // Half-angle formulas from cos 2t = half / radius, sin 2t = s_xy / radius:
-    // no trigonometric calls in the innermost loop of the damage law.
-    const double cos2 = half / radius;
+    // no trigonometric calls in the innermost loop of the damage law. Where
+    // the squares fall below the normal numbers (entries under 1e-154, as a
+    // grid's round-off spreads through a body at rest) the radius keeps few
+    // bits and may come out below |half|: cos 2t is held to [-1, 1], else the
+    // half-angle roots turned NaN and the body with them. Above, the radius
+    // is never below |half| and the bound changes nothing. By value: GCC 12
+    // vectorises no std::clamp here (its references become masked loads).
+    const double ratio = half / radius;
+    const double cos2 = ratio > 1 ? 1.0 : (ratio < -1 ? -1.0 : ratio);
     const bool equal = radius == 0;  // any direction is principal
     a = equal ? centre : centre + radius;
     b = equal ? centre : centre - radius;
