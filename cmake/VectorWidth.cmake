@@ -10,13 +10,13 @@ function(outburst_vector_bytes var)
   if(NOT CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
     return()
   endif()
-  string(TOUPPER "${CMAKE_BUILD_TYPE}" type)
-  separate_arguments(flags UNIX_COMMAND "${CMAKE_CXX_FLAGS} ${CMAKE_CXX_FLAGS_${type}}")
+  # The Release flags: the caller asks for Release builds only.
+  separate_arguments(flags UNIX_COMMAND "${CMAKE_CXX_FLAGS} ${CMAKE_CXX_FLAGS_RELEASE}")
   if(OUTBURST_NATIVE)
     list(APPEND flags -march=native)
   endif()
   execute_process(
-    COMMAND ${CMAKE_CXX_COMPILER} ${flags} -O3 -fopt-info-vec-optimized -S -o /dev/null
+    COMMAND ${CMAKE_CXX_COMPILER} ${flags} -fopt-info-vec-optimized -S -o ${CMAKE_BINARY_DIR}/vector_width_probe.s
             ${PROJECT_SOURCE_DIR}/cmake/vector_width_probe.cpp
     RESULT_VARIABLE failed OUTPUT_VARIABLE report ERROR_VARIABLE report)
   # The first report is the loop's main body (an epilogue may follow, narrower).

@@ -26,7 +26,8 @@ namespace outburst::mpm::gathers {
 // GCC's vector extensions: a node's two components.
 using Pair = double __attribute__((vector_size(16)));
 
-// A Vec<2> may lie wherever a double may.
+// Through memcpy: the nodal arrays are doubles to the compiler (Eigen aligns
+// a Vec<2> to 16 bytes, the tests' arrays to 8).
 [[gnu::always_inline]] inline Pair load_pair(const double* at) {
   Pair v;
   std::memcpy(&v, at, sizeof v);
@@ -34,13 +35,14 @@ using Pair = double __attribute__((vector_size(16)));
 }
 
 // |c|^2 as the lanes' loop rounds it: there GCC fuses the second square into
-// the first where the processor fuses (FMA) and the build lets it
-// (CMakeLists.txt, OUTBURST_NO_FP_CONTRACTION). Written out as the lanes
+// the first where the processor has a fused multiply-add and the build lets
+// GCC contract (CMakeLists.txt, OUTBURST_NO_FP_CONTRACTION; auto picks pairs
+// only for optimised builds, where GCC contracts). Written out as the lanes
 // write it, the pair's two squares became one vector product and the fusion
 // was lost: the motion's spread, and with it the transfer's energy books,
-// then differed in their last bits.
+// then differed in their last bits (tests/test_mpm_stencil.cpp).
 [[gnu::always_inline]] inline double squared_norm(Pair c) {
-#if defined(__FMA__) && !defined(OUTBURST_NO_FP_CONTRACTION)
+#if defined(__FP_FAST_FMA) && !defined(OUTBURST_NO_FP_CONTRACTION)
   return std::fma(c[1], c[1], c[0] * c[0]);
 #else
   return c[0] * c[0] + c[1] * c[1];

@@ -95,7 +95,8 @@ inline constexpr int chunk_lanes = 32;
 // formed where a pass uses them, to the same bits as Stencil::compute's
 // (under unit slopes a factor of -1 or 1 taken as a sign). Nothing per node
 // is stored and read back, and the gathers' node loops run over the lanes,
-// for the compiler to vectorise (README.md, The MPM solver, has what it
+// for the compiler to vectorise, or over a lane's nodes a pair of components
+// at a time (mpm_solid/gathers.hpp; README.md, The MPM solver, has what each
 // gained).
 template <int Dim, class Shape, int Width = chunk_lanes>
 struct StencilLanes {
