@@ -518,6 +518,9 @@ for name, written in [
     ("mpm benchmark dp screen avx2", "compare-3b3d886-dp-screen.csv"),
     ("mpm benchmark dp screen bounded avx2", "compare-3b3d886-dp-screen-bounded.csv"),
     ("mpm benchmark screen avx2", "compare-63e0ffd-screen-epyc.csv"),
+    ("mpm benchmark gather pairs avx2", "compare-610a245-gather-pairs.csv"),
+    ("mpm benchmark gather pairs generic", "compare-generic-gather-pairs.csv"),
+    ("mpm benchmark pairs avx2", "compare-63e0ffd-pairs-epyc.csv"),
 ]:
     block(name, "mpm_solid/benchmark/" + written)(mpm_benchmark_builds)
 
@@ -587,10 +590,11 @@ def mpm_benchmark(rows):
     return lines
 
 
-# mpm-benchmark's own CSVs from the AVX2 processor of "The same builds on another processor": before and
-# after the plastic rows' yield check over lanes.
+# mpm-benchmark's own CSVs from the AVX2 processor of "The same builds on another processor": before the
+# plastic rows' yield check over lanes, after it, and after the gathers' node pairs.
 for name, written in [("mpm benchmark avx2", "mpm-benchmark-avx2.csv"),
-                      ("mpm benchmark avx2 screen", "mpm-benchmark-avx2-screen.csv")]:
+                      ("mpm benchmark avx2 screen", "mpm-benchmark-avx2-screen.csv"),
+                      ("mpm benchmark avx2 pairs", "mpm-benchmark-avx2-pairs.csv")]:
     block(name, "mpm_solid/benchmark/" + written)(mpm_benchmark)
 
 
