@@ -48,8 +48,9 @@ struct Principal<2> {
     // grid's round-off spreads through a body at rest) the radius keeps few
     // bits and may come out below |half|: cos 2t is held to [-1, 1], else the
     // half-angle roots turned NaN and the body with them. Above, the radius
-    // is never below |half| and the bound changes nothing. By value: GCC 12
-    // vectorises no std::clamp here (its references become masked loads).
+    // is never below |half| and the bound changes nothing. By value, as the
+    // yield screen's maxima are (drucker_prager.cpp: std::max's references
+    // became masked loads there, which kept its lanes scalar).
     const double ratio = half / radius;
     const double cos2 = ratio > 1 ? 1.0 : (ratio < -1 ? -1.0 : ratio);
     const bool equal = radius == 0;  // any direction is principal
