@@ -15,7 +15,6 @@
 
 #include <algorithm>
 #include <array>
-#include <cmath>
 #include <cstddef>
 #include <cstring>
 
@@ -32,21 +31,6 @@ using Pair = double __attribute__((vector_size(16)));
   Pair v;
   std::memcpy(&v, at, sizeof v);
   return v;
-}
-
-// |c|^2 as the lanes' loop rounds it: there GCC fuses the second square into
-// the first where the processor has a fused multiply-add and the build lets
-// GCC contract (CMakeLists.txt, OUTBURST_NO_FP_CONTRACTION; auto picks pairs
-// only for optimised builds, where GCC contracts). Written out as the lanes
-// write it, the pair's two squares became one vector product and the fusion
-// was lost: the motion's spread, and with it the transfer's energy books,
-// then differed in their last bits (tests/test_mpm_stencil.cpp).
-[[gnu::always_inline]] inline double squared_norm(Pair c) {
-#if defined(__FP_FAST_FMA) && !defined(OUTBURST_NO_FP_CONTRACTION)
-  return std::fma(c[1], c[1], c[0] * c[0]);
-#else
-  return c[0] * c[0] + c[1] * c[1];
-#endif
 }
 
 // L = grad v from the nodal velocities (Dim components a node) at the
@@ -91,51 +75,40 @@ template <bool Pairs, int Dim, class Shape, int Width>
 
 // The motion update's sums over the nodes of each lane's stencil, from the
 // nodal velocities before (now) and after (next) the grid update: v_pic =
-// sum w v_next, dv = sum w (v_next - v_now) and spread = sum w |v_next -
-// v_now|^2. The sums start from zero.
+// sum w v_next and dv = sum w (v_next - v_now). The sums start from zero.
 template <bool Pairs, int Dim, class Shape, int Width>
 [[gnu::always_inline]] inline void motion_sums(const double* now, const double* next,
                                                const StencilLanes<Dim, Shape, Width>& s, int lanes,
-                                               double (&v_pic)[Dim][Width], double (&dv)[Dim][Width],
-                                               double (&spread)[Width]) {
+                                               double (&v_pic)[Dim][Width], double (&dv)[Dim][Width]) {
   if constexpr (Pairs && Dim == 2) {
     for (int lane = 0; lane < lanes; ++lane) {
       const double *v = now + 2 * s.first[lane], *v_new = next + 2 * s.first[lane];
       Pair pic = {}, change_sum = {};
-      double spread_sum = 0;
       s.for_each_node([&](int k, const std::array<int, Dim>& a) __attribute__((always_inline)) {
         const double weight = s.weight(a, lane);
-        const Pair at_new = load_pair(v_new + 2 * s.offset[k]), change = at_new - load_pair(v + 2 * s.offset[k]);
+        const Pair at_new = load_pair(v_new + 2 * s.offset[k]);
         pic += weight * at_new;
-        change_sum += weight * change;
-        spread_sum += weight * squared_norm(change);
+        change_sum += weight * (at_new - load_pair(v + 2 * s.offset[k]));
       });
       for (int e = 0; e < 2; ++e) {
         v_pic[e][lane] = pic[e];
         dv[e][lane] = change_sum[e];
       }
-      spread[lane] = spread_sum;
     }
   } else {
-    for (int lane = 0; lane < lanes; ++lane) {
+    for (int lane = 0; lane < lanes; ++lane)
       for (int e = 0; e < Dim; ++e) v_pic[e][lane] = dv[e][lane] = 0;
-      spread[lane] = 0;
-    }
     s.for_each_node([&](int k, const std::array<int, Dim>& a) {
       const std::ptrdiff_t offset = s.offset[k];
 #pragma omp simd
       for (int lane = 0; lane < lanes; ++lane) {
         const double weight = s.weight(a, lane);
         const double *v = now + Dim * (s.first[lane] + offset), *v_new = next + Dim * (s.first[lane] + offset);
-        double squared = 0;
 #pragma GCC unroll 3
         for (int e = 0; e < Dim; ++e) {
-          const double change = v_new[e] - v[e];
           v_pic[e][lane] += weight * v_new[e];
-          dv[e][lane] += weight * change;
-          squared += change * change;
+          dv[e][lane] += weight * (v_new[e] - v[e]);
         }
-        spread[lane] += weight * squared;
       }
     });
   }

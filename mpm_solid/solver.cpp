@@ -847,21 +847,31 @@ void Solver<Dim>::grid_update(double dt) {
   }
   apply_platens(velocity_new_, shrink * dt, dt);  // before the walls: the ghost nodes mirror the plate's motion
   dissipated_.walls += apply_walls(velocity_new_);
-  // The grid's work on pure FLIP particles is sum_i p_i . dv_i here, with
-  // the momenta p_i they mapped, plus sum_p m_p sum_i w_ip |dv_i|^2 / 2 in
-  // gather_motion (Solver::energies). Walls and platens changed p_i to
-  // m_i v_i before the update: that change, worked by the update, is theirs.
-  double work = 0, projected = 0;
+  // The grid's work on pure FLIP particles is sum_i p_i . dv_i, with the
+  // momenta p_i they mapped, plus sum_p m_p sum_i w_ip |dv_i|^2 / 2
+  // (Solver::energies). Walls and platens changed p_i to m_i v_i before the
+  // update: that change, worked by the update, is theirs. The second sum,
+  // the increment's spread, is the nodes' sum_i m_i |dv_i|^2 / 2: the nodal
+  // masses are the particles' mapped with the same weights, a ghost's folded
+  // into its mirror, whose |dv| it shares (as the first sum takes its p_i;
+  // not quite at a corner where a fixed or roller wall meets a friction one,
+  // whose ghosts friction constrains after the mirror). Taken particle by
+  // particle, over each stencil's nodes, it cost the step 4-5 % (README.md,
+  // "The transfer's spread over the nodes"); it is also all the transfer
+  // keeps, less sum_p m_p |dv_p|^2 / 2 (gather_motion).
+  double work = 0, projected = 0, spread = 0;
   const int nr = static_cast<int>(runs.size());
-#pragma omp parallel for schedule(static) reduction(+ : work, projected)
+#pragma omp parallel for schedule(static) reduction(+ : work, projected, spread)
   for (int r = 0; r < nr; ++r)
     for (std::size_t i = runs[r].first, end = i + static_cast<std::size_t>(runs[r].count); i < end; ++i)
       if (counted_[i]) {
         const Vec<Dim> change = velocity_new_[i] - velocity_[i];
         work += mass_[i] * velocity_[i].dot(change);
         projected += (momentum_[i] - mass_[i] * velocity_[i]).dot(change);
+        spread += mass_[i] * change.squaredNorm();
       }
-  dissipated_.grid_work += work + projected;
+  dissipated_.grid_work += work + projected + 0.5 * spread;
+  dissipated_.transfer += 0.5 * spread;
   dissipated_.walls -= projected;
   if (c > 0) {
     // The damping force -c m v_new works along the way the nodes carry the
@@ -1097,20 +1107,19 @@ void Solver<Dim>::gather_motion(double dt) {
   const int n = static_cast<int>(p.size());
   const double flip = settings_.flip_fraction;
   Census census;
-  double lost = 0, work = 0, gained = 0;
+  double lost = 0, work = 0;
   const bool loads = !lean_build && !p.external_force.empty();
   // The new velocities and positions of particles start .. start + lanes - 1
-  // from what their stencils gathered (lane by lane: v_pic, dv, spread and,
-  // under APIC, affine), the energy books and, under Move, the census; the
-  // calling thread's census and sums passed in, since a lambda made out here
-  // would capture the shared ones rather than the thread's reduction copies.
-  // Over SIMD lanes, the sums then taken particle by particle, in order.
+  // from what their stencils gathered (lane by lane: v_pic, dv and, under
+  // APIC, affine), the energy books and, under Move, the census; the calling
+  // thread's census and sums passed in, since a lambda made out here would
+  // capture the shared ones rather than the thread's reduction copies. Over
+  // SIMD lanes, the sums then taken particle by particle, in order.
   const auto finish = [&]<int Width>(int start, int lanes, const double(&v_pic)[Dim][Width],
-                                     const double(&dv)[Dim][Width], const double(&spread)[Width],
-                                     const double* affine, Census& census, double& lost, double& work,
-                                     double& gained) __attribute__((always_inline)) {
+                                     const double(&dv)[Dim][Width], const double* affine, Census& census,
+                                     double& lost, double& work) __attribute__((always_inline)) {
     static_assert(Width <= chunk_lanes, "count() books at most chunk_lanes particles");
-    alignas(64) double gain[Width], loss[Width], blend[Width], load_work[Width];
+    alignas(64) double loss[Width], blend[Width], load_work[Width];
     double *x = p.x.data()->data(), *v = p.v.data()->data(), *displacement = Move ? nullptr : displacement_.data()->data();
     const auto over_lanes = [&](auto loaded) __attribute__((always_inline)) {
 #pragma omp simd
@@ -1120,10 +1129,11 @@ void Solver<Dim>::gather_motion(double dt) {
         // Pure FLIP hands each particle the grid's change, interpolated: its
         // kinetic energy gains m (v . dv + |dv|^2 / 2), short of the grid's
         // share m ((v + affine) . dv + sum w |dv_i|^2 / 2) by the increment's
-        // spread over the stencil (and under APIC the affine term). It keeps
-        // what the grid cannot hold (sub-cell velocity differences); the PIC
-        // share, and APIC, replace that with the grid's field. All of it is
-        // what the transfer takes.
+        // spread over the stencil (summed over the nodes: grid_update) less
+        // m |dv|^2 / 2 (and under APIC the affine term). It keeps what the
+        // grid cannot hold (sub-cell velocity differences); the PIC share,
+        // and APIC, replace that with the grid's field. All of it is what the
+        // transfer takes.
         double v_flip[Dim], v_new[Dim];
 #pragma GCC unroll 3
         for (int e = 0; e < Dim; ++e) {
@@ -1134,8 +1144,7 @@ void Solver<Dim>::gather_motion(double dt) {
         const double change = sum_of_squares<Dim>([&](int e) { return dv[e][lane]; }),
                      before = sum_of_squares<Dim>([&](int e) { return v_flip[e]; }),
                      after = sum_of_squares<Dim>([&](int e) { return v_new[e]; });
-        gain[lane] = 0.5 * m * spread[lane];
-        loss[lane] = 0.5 * m * (spread[lane] - change);
+        loss[lane] = -0.5 * m * change;
         if constexpr (Apic) loss[lane] += m * affine[lane];
         blend[lane] = 0.5 * m * (before - after);
         // The external force works along the way the particle went, at the
@@ -1164,14 +1173,13 @@ void Solver<Dim>::gather_motion(double dt) {
       over_lanes(std::false_type{});
     }
     for (int lane = 0; lane < lanes; ++lane) {
-      gained += gain[lane];
       lost += loss[lane];
       lost += blend[lane];
     }
     if constexpr (Move) count(start, lanes, dt, census);
   };
   if constexpr (Apic) {
-#pragma omp parallel reduction(merge : census) reduction(+ : lost, work, gained)
+#pragma omp parallel reduction(merge : census) reduction(+ : lost, work)
     {
       const Lattice<Dim> lattice(grid_);
       Stencil<Dim, Shape> s;
@@ -1181,14 +1189,12 @@ void Solver<Dim>::gather_motion(double dt) {
         Vec<Dim> v_pic = Vec<Dim>::Zero(), dv = Vec<Dim>::Zero();
         Mat<Dim> b = Mat<Dim>::Zero();
         Vec<Dim> d = Vec<Dim>::Zero();  // diagonal of D = sum w (x_i - x_p)(x_i - x_p)^T
-        double spread = 0;              // sum w |dv_i|^2
         double affine = 0;              // sum w (C (x_i - x_p)) . dv_i
         for (int k = 0; k < s.count; ++k) {
           const auto node = s.node[k];
           const Vec<Dim> change = velocity_new_[node] - velocity_[node];
           v_pic += s.weight[k] * velocity_new_[node];
           dv += s.weight[k] * change;
-          spread += s.weight[k] * change.squaredNorm();
           b += s.weight[k] * velocity_new_[node] * s.offset[k].transpose();
           d += s.weight[k] * s.offset[k].cwiseProduct(s.offset[k]);
           // The affine share of the momentum this particle mapped, which
@@ -1200,7 +1206,7 @@ void Solver<Dim>::gather_motion(double dt) {
           pic[e][0] = v_pic[e];
           change[e][0] = dv[e];
         }
-        finish(i, 1, pic, change, {spread}, &affine, census, lost, work, gained);
+        finish(i, 1, pic, change, &affine, census, lost, work);
         // D is diagonal for tensor-product shapes that reproduce linear fields;
         // a particle on a linear-shape node has D = 0 along that axis (and B too).
         for (int c = 0; c < Dim; ++c)
@@ -1217,7 +1223,7 @@ void Solver<Dim>::gather_motion(double dt) {
     Scatter<double> masses{thread_mass_, mass_, active_.runs()};
     Scatter<Vec<Dim>> momenta{thread_vector_, momentum_, active_.runs()};
     long outside = 0;
-#pragma omp parallel num_threads(threads_) reduction(merge : census) reduction(+ : lost, work, gained, outside)
+#pragma omp parallel num_threads(threads_) reduction(merge : census) reduction(+ : lost, work, outside)
     {
       const Lattice<Dim> lattice(grid_);
       Lanes s(lattice), ahead(lattice);
@@ -1232,10 +1238,10 @@ void Solver<Dim>::gather_motion(double dt) {
         reached = active_.marks(omp_get_thread_num());
       }
       over_chunks(s, p, [&](int start, int lanes) __attribute__((always_inline)) {
-        alignas(64) double v_pic[Dim][Lanes::width], dv[Dim][Lanes::width], spread[Lanes::width];
-        gathers::motion_sums<gather_pairs>(now, next, s, lanes, v_pic, dv, spread);
+        alignas(64) double v_pic[Dim][Lanes::width], dv[Dim][Lanes::width];
+        gathers::motion_sums<gather_pairs>(now, next, s, lanes, v_pic, dv);
         const long troubled = census.bad + census.runaway;
-        finish(start, lanes, v_pic, dv, spread, nullptr, census, lost, work, gained);
+        finish(start, lanes, v_pic, dv, nullptr, census, lost, work);
         if constexpr (Move) {
           // A chunk the census found a non-finite or runaway particle in is
           // not mapped (its positions may lie beyond int's range, where the
@@ -1262,7 +1268,6 @@ void Solver<Dim>::gather_motion(double dt) {
   if constexpr (Move) census_ = census;
   dissipated_.transfer += lost;
   dissipated_.external += work;
-  dissipated_.grid_work += gained;
 }
 
 // Every transfer of a step uses the particles' positions at its start; they move
