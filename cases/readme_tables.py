@@ -521,6 +521,8 @@ for name, written in [
     ("mpm benchmark gather pairs avx2", "compare-610a245-gather-pairs.csv"),
     ("mpm benchmark gather pairs generic", "compare-generic-gather-pairs.csv"),
     ("mpm benchmark pairs avx2", "compare-63e0ffd-pairs-epyc.csv"),
+    ("mpm benchmark nodal spread avx2", "compare-a34f189-nodal-spread.csv"),
+    ("mpm benchmark nodal spread 63e0ffd avx2", "compare-63e0ffd-nodal-spread-epyc.csv"),
 ]:
     block(name, "mpm_solid/benchmark/" + written)(mpm_benchmark_builds)
 
