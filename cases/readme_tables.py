@@ -523,6 +523,7 @@ for name, written in [
     ("mpm benchmark pairs avx2", "compare-63e0ffd-pairs-epyc.csv"),
     ("mpm benchmark nodal spread avx2", "compare-a34f189-nodal-spread.csv"),
     ("mpm benchmark nodal spread 63e0ffd avx2", "compare-63e0ffd-nodal-spread-epyc.csv"),
+    ("mpm benchmark 3d nodal spread avx2", "compare-3d-a34f189-nodal-spread.csv"),
 ]:
     block(name, "mpm_solid/benchmark/" + written)(mpm_benchmark_builds)
 
@@ -593,10 +594,12 @@ def mpm_benchmark(rows):
 
 
 # mpm-benchmark's own CSVs from the AVX2 processor of "The same builds on another processor": before the
-# plastic rows' yield check over lanes, after it, and after the gathers' node pairs.
+# plastic rows' yield check over lanes, after it, after the gathers' node pairs and after the
+# transfer's spread over the nodes.
 for name, written in [("mpm benchmark avx2", "mpm-benchmark-avx2.csv"),
                       ("mpm benchmark avx2 screen", "mpm-benchmark-avx2-screen.csv"),
-                      ("mpm benchmark avx2 pairs", "mpm-benchmark-avx2-pairs.csv")]:
+                      ("mpm benchmark avx2 pairs", "mpm-benchmark-avx2-pairs.csv"),
+                      ("mpm benchmark avx2 nodal spread", "mpm-benchmark-avx2-nodal.csv")]:
     block(name, "mpm_solid/benchmark/" + written)(mpm_benchmark)
 
 
