@@ -243,6 +243,9 @@ void refuse_in_lean_build(bool named, const char* what) {
 // Friction walls act only on nodes moving into them: the normal velocity is
 // removed and the tangential one reduced by mu times that change. Returns the
 // work done by friction (fixed and roller walls do none: the wall does not move).
+// Fixed and roller walls mirror their ghost nodes (fold_ghosts, apply_walls).
+bool mirrors(Wall::Type type) { return type == Wall::Type::fixed || type == Wall::Type::roller; }
+
 template <int Dim>
 double constrain(Vec<Dim>& v, const Vec<Dim>& n, const Wall& wall, double mass) {
   const double vn = v.dot(n);
@@ -348,9 +351,7 @@ Solver<Dim>::Solver(Grid<Dim> grid, std::vector<std::unique_ptr<Material<Dim>>> 
       active_(grid_,
               [&] {
                 std::array<bool, 2 * Dim> mirrored{};
-                for (int side = 0; side < 2 * Dim; ++side)
-                  mirrored[side] = settings.walls[side].type == Wall::Type::fixed ||
-                                   settings.walls[side].type == Wall::Type::roller;
+                for (int side = 0; side < 2 * Dim; ++side) mirrored[side] = mirrors(settings.walls[side].type);
                 return mirrored;
               }(),
               omp_get_max_threads()) {
@@ -372,8 +373,7 @@ Solver<Dim>::Solver(Grid<Dim> grid, std::vector<std::unique_ptr<Material<Dim>>> 
   }
   counted_.assign(n, 1);
   for (int side = 0; side < 2 * Dim; ++side) {
-    const auto type = settings_.walls[side].type;
-    if (type != Wall::Type::fixed && type != Wall::Type::roller) continue;
+    if (!mirrors(settings_.walls[side].type)) continue;
     const int axis = side / 2, g = Grid<Dim>::ghost;
     const int wall_row = side % 2 == 0 ? g : g + grid_.cells[axis];
     for (std::size_t i = 0; i < n; ++i)
@@ -854,8 +854,8 @@ void Solver<Dim>::grid_update(double dt) {
   // the increment's spread, is the nodes' sum_i m_i |dv_i|^2 / 2: the nodal
   // masses are the particles' mapped with the same weights, a ghost's folded
   // into its mirror, whose |dv| it shares (as the first sum takes its p_i;
-  // not quite at a corner where a fixed or roller wall meets a friction one,
-  // whose ghosts friction constrains after the mirror). Taken particle by
+  // apply_walls leaves every ghost its mirror's motion, where a friction wall
+  // meets a fixed one too). Taken particle by
   // particle, over each stencil's nodes, it cost the step 4-5 % (README.md,
   // "The transfer's spread over the nodes"); it is also all the transfer
   // keeps, less sum_p m_p |dv_p|^2 / 2 (gather_motion).
@@ -910,29 +910,38 @@ void Solver<Dim>::over_layer(int axis, int row, F&& f) const {
 
 template <int Dim>
 template <class F>
+void Solver<Dim>::over_ghost_layer(int side, int depth, F&& f) const {
+  const int g = Grid<Dim>::ghost, axis = side / 2;
+  const int outward = side % 2 == 0 ? -1 : 1;  // wall normal, out of the domain
+  const int wall_row = outward < 0 ? g : g + grid_.cells[axis];
+  const std::ptrdiff_t inward = -2 * depth * outward * grid_.stride(axis);
+  over_layer(axis, wall_row + depth * outward, [&](std::size_t node) { f(node, node + inward); });
+}
+
+namespace {
+// A vector at a node reflected across a fixed or roller wall normal to
+// `axis`: the normal component odd, the tangential ones odd at a fixed wall
+// (no slip) and even at a roller.
+template <int Dim>
+Vec<Dim> reflected(const Vec<Dim>& v, int axis, Wall::Type type) {
+  Vec<Dim> r;
+  for (int d = 0; d < Dim; ++d) r[d] = d == axis || type == Wall::Type::fixed ? -v[d] : v[d];
+  return r;
+}
+}  // namespace
+
+template <int Dim>
+template <class F>
 void Solver<Dim>::fold_ghosts(std::vector<double>* mass, std::vector<Vec<Dim>>& vectors, F&& refresh) const {
-  const int g = Grid<Dim>::ghost;
   for (int side = 0; side < 2 * Dim; ++side) {
-    const Wall& wall = settings_.walls[side];
-    if (wall.type != Wall::Type::fixed && wall.type != Wall::Type::roller) continue;
-    const int axis = side / 2;
-    const int outward = side % 2 == 0 ? -1 : 1;
-    const int wall_row = outward < 0 ? g : g + grid_.cells[axis];
-    const double tangential = wall.type == Wall::Type::fixed ? -1.0 : 1.0;
-    for (int depth = 1; depth <= g; ++depth) {
-      // From the ghost `depth` rows out to its mirror as far in.
-      const std::ptrdiff_t inward = -2 * depth * outward * grid_.stride(axis);
-      over_layer(axis, wall_row + depth * outward, [&](std::size_t from) {
-        const std::size_t to = from + inward;
+    const Wall::Type type = settings_.walls[side].type;
+    if (!mirrors(type)) continue;
+    for (int depth = 1; depth <= Grid<Dim>::ghost; ++depth)
+      over_ghost_layer(side, depth, [&](std::size_t from, std::size_t to) {
         if (mass) (*mass)[to] += (*mass)[from];
-        for (int d = 0; d < Dim; ++d)
-          if (d == axis)
-            vectors[to][d] -= vectors[from][d];
-          else
-            vectors[to][d] += tangential * vectors[from][d];
+        vectors[to] += reflected<Dim>(vectors[from], side / 2, type);
         refresh(to);
       });
-    }
   }
 }
 
@@ -947,68 +956,88 @@ void Solver<Dim>::fold_ghosts(std::vector<double>* mass, std::vector<Vec<Dim>>& 
 // Returns the work done by friction.
 template <int Dim>
 double Solver<Dim>::apply_walls(std::vector<Vec<Dim>>& velocity) const {
-  const int g = Grid<Dim>::ghost;
   double friction_work = 0;
+  // The wall's condition at a node of its own motion: a wall row's, or a
+  // ghost's beyond a friction wall, which keeps its own mass.
+  const auto condition = [&](int side) {
+    const Wall& wall = settings_.walls[side];
+    Vec<Dim> normal = Vec<Dim>::Zero();
+    normal[side / 2] = side % 2 == 0 ? -1 : 1;
+    return [&wall, normal, &velocity, &friction_work, this](std::size_t i, std::size_t) {
+      const double work = constrain(velocity[i], normal, wall, mass_[i]);
+      // A ghost beyond a fixed or roller wall takes its mirror's motion
+      // next, and its mass is folded into that node's: its work is not its own.
+      if (counted_[i]) friction_work += work;
+    };
+  };
   // On the wall rows friction acts last: where a friction wall meets another
   // in 3D, the other's normal velocity is not slip along the friction wall
   // (in the plane the order makes no difference there).
-  std::array<int, 2 * Dim> in_turn, friction_last;
-  std::iota(in_turn.begin(), in_turn.end(), 0);
-  friction_last = in_turn;
+  std::array<int, 2 * Dim> friction_last;
+  std::iota(friction_last.begin(), friction_last.end(), 0);
   std::stable_partition(friction_last.begin(), friction_last.end(),
                         [&](int side) { return settings_.walls[side].type != Wall::Type::friction; });
-  // Wall rows first, then ghost rows outward, so that every mirror is final
-  // when it is read (thin domains mirror one wall's ghosts in the other's).
-  for (int depth = 0; depth <= g; ++depth) {
-    for (const int side : depth == 0 ? friction_last : in_turn) {
-      const Wall& wall = settings_.walls[side];
-      if (wall.type == Wall::Type::open) continue;
-      const int axis = side / 2;
-      const int outward = side % 2 == 0 ? -1 : 1;  // wall normal, out of the domain
-      const int wall_row = outward < 0 ? g : g + grid_.cells[axis];
-      Vec<Dim> normal = Vec<Dim>::Zero();
-      normal[axis] = outward;
-      const std::ptrdiff_t inward = -2 * depth * outward * grid_.stride(axis);  // to the mirror
-      over_layer(axis, wall_row + depth * outward, [&](std::size_t i) {
-        Vec<Dim>& v = velocity[i];
-        if (depth > 0 && wall.type != Wall::Type::friction) {
-          const Vec<Dim>& m = velocity[i + inward];
-          for (int d = 0; d < Dim; ++d) v[d] = d == axis || wall.type == Wall::Type::fixed ? -m[d] : m[d];
-          return;
+  for (const int side : friction_last)
+    if (settings_.walls[side].type != Wall::Type::open) over_ghost_layer(side, 0, condition(side));
+  // Most of an obstacle's nodes lie deep in the rock, where no particle
+  // reaches: outside the active runs, at rest, which every contact leaves
+  // at rest. Both lists are in node order (find_obstacle_nodes goes along
+  // the nodes), so a walk along the runs from the obstacle's first node
+  // visits its active nodes in the order the full list would.
+  const auto& runs = active_.runs();
+  for (std::size_t k = 0; k < obstacle_nodes_.size(); ++k) {
+    const Wall& contact = settings_.obstacles[k].contact;
+    auto o = obstacle_nodes_[k].cbegin();
+    const auto end = obstacle_nodes_[k].cend();
+    if (o == end) continue;
+    // The first run that ends beyond the obstacle's first node.
+    auto run = std::upper_bound(runs.begin(), runs.end(), o->node, [](std::size_t i, const NodeRun& r) {
+      return i < r.first + static_cast<std::size_t>(r.count);
+    });
+    for (; run != runs.end() && o != end; ++run) {
+      o = std::lower_bound(o, end, run->first, [](const ObstacleNode& a, std::size_t i) { return a.node < i; });
+      for (; o != end && o->node < run->first + static_cast<std::size_t>(run->count); ++o)
+        if (const Vec<Dim>& v = velocity[o->node]; (v.array() != 0).any()) {
+          const double work = constrain(velocity[o->node], o->normal, contact, mass_[o->node]);
+          if (counted_[o->node]) friction_work += work;
         }
-        // A ghost beyond a fixed or roller wall takes its mirror's motion
-        // next, and its mass is folded into that node's: its work is not its own.
-        const double work = constrain(v, normal, wall, mass_[i]);
-        if (counted_[i]) friction_work += work;
-      });
-    }
-    if (depth > 0) continue;
-    // Most of an obstacle's nodes lie deep in the rock, where no particle
-    // reaches: outside the active runs, at rest, which every contact leaves
-    // at rest. Both lists are in node order (find_obstacle_nodes goes along
-    // the nodes), so a walk along the runs from the obstacle's first node
-    // visits its active nodes in the order the full list would.
-    const auto& runs = active_.runs();
-    for (std::size_t k = 0; k < obstacle_nodes_.size(); ++k) {
-      const Wall& contact = settings_.obstacles[k].contact;
-      auto o = obstacle_nodes_[k].cbegin();
-      const auto end = obstacle_nodes_[k].cend();
-      if (o == end) continue;
-      // The first run that ends beyond the obstacle's first node.
-      auto run = std::upper_bound(runs.begin(), runs.end(), o->node, [](std::size_t i, const NodeRun& r) {
-        return i < r.first + static_cast<std::size_t>(r.count);
-      });
-      for (; run != runs.end() && o != end; ++run) {
-        o = std::lower_bound(o, end, run->first, [](const ObstacleNode& a, std::size_t i) { return a.node < i; });
-        for (; o != end && o->node < run->first + static_cast<std::size_t>(run->count); ++o)
-          if (const Vec<Dim>& v = velocity[o->node]; (v.array() != 0).any()) {
-            const double work = constrain(velocity[o->node], o->normal, contact, mass_[o->node]);
-            if (counted_[o->node]) friction_work += work;
-          }
-      }
     }
   }
+  // Then the ghost rows: those beyond friction walls first, then those beyond
+  // fixed and roller walls, row by row outward, so that every mirror is final
+  // when it is read. Thin domains mirror one wall's ghosts in the other's;
+  // where a fixed wall meets a friction one, the corner's ghosts mirror ghosts
+  // beyond the friction wall, into which fold_ghosts put their masses, and
+  // with which the energy books take them to share |dv| (grid_update).
+  // Constrained in turn with the mirrors, depth by depth, a corner ghost
+  // could copy a friction wall's ghost before friction slowed it, and
+  // friction then constrained the copy as a node of its own, whose normal
+  // velocity a fixed wall's reflection had turned: either way not its
+  // mirror's reflection. (A roller's reflection keeps the normal velocity
+  // and the slip's length: friction commutes with it.)
+  for (int side = 0; side < 2 * Dim; ++side)
+    if (settings_.walls[side].type == Wall::Type::friction)
+      for (int depth = 1; depth <= Grid<Dim>::ghost; ++depth) over_ghost_layer(side, depth, condition(side));
+  for (int depth = 1; depth <= Grid<Dim>::ghost; ++depth)
+    for (int side = 0; side < 2 * Dim; ++side)
+      if (const Wall::Type type = settings_.walls[side].type; mirrors(type))
+        over_ghost_layer(side, depth, [&](std::size_t ghost, std::size_t mirror) {
+          velocity[ghost] = reflected<Dim>(velocity[mirror], side / 2, type);
+        });
   return friction_work;
+}
+
+template <int Dim>
+std::size_t Solver<Dim>::unmirrored_ghosts() const {
+  std::size_t wrong = 0;
+  for (int side = 0; side < 2 * Dim; ++side)
+    if (const Wall::Type type = settings_.walls[side].type; mirrors(type))
+      for (int depth = 1; depth <= Grid<Dim>::ghost; ++depth)
+        over_ghost_layer(side, depth, [&](std::size_t ghost, std::size_t mirror) {
+          for (const auto* field : {&velocity_, &velocity_new_})
+            if ((*field)[ghost] != reflected<Dim>((*field)[mirror], side / 2, type)) ++wrong;
+        });
+  return wrong;
 }
 
 template <int Dim>

@@ -313,6 +313,13 @@ class Solver {
   // sums): none between steps, the invariant the grid's passes rely on
   // (checked by the tests).
   std::size_t stray_nodal_values() const;
+  // The velocities (before and after the last step's grid update) of ghost
+  // nodes beyond fixed and roller walls that are not their mirror's
+  // reflected: none, the invariant the energy books rely on, as fold_ghosts
+  // put each ghost's mass into its mirror (checked by the tests). Active
+  // blocks come and go across a mirroring wall whole, ghost and mirror
+  // together (ActiveBlocks), so it holds after USF's mapping ahead too.
+  std::size_t unmirrored_ghosts() const;
 
   // Memory held now [bytes]: by the particles (every field, and the per-step
   // arrays sized by them) and by the grid (the nodal arrays, one set per thread).
@@ -357,6 +364,10 @@ class Solver {
   // nodal value is zero, which walls and folds leave so.
   template <class F>
   void over_layer(int axis, int row, F&& f) const;
+  // f(node, mirror) over the nodes `depth` rows beyond wall `side` (0: its
+  // wall row), as over_layer visits them; mirror the node as far inside.
+  template <class F>
+  void over_ghost_layer(int side, int depth, F&& f) const;
   void update_stresses(double dt);
   // At most chunk_lanes particles.
   void count(int start, int lanes, double dt, Census& census) const;

@@ -1,5 +1,6 @@
 // Contact: friction on a slope and on rigid obstacles, bodies resting on
-// obstacles and supports (the settling stage), and rigid platens.
+// obstacles and supports (the settling stage), rigid platens, and the ghost
+// nodes where a friction wall meets a fixed or roller one.
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -281,4 +282,55 @@ TEST_CASE("material pressed into an obstacle that stands on a wall keeps its ene
   INFO("books open by " << audit.open_share() << " of the largest term, " << audit.largest_term() << " J/m");
   CHECK(audit.open_share() < 1e-12);
   CHECK(solver.energies().walls > 0);  // the friction worked
+}
+
+// Where a fixed or roller wall meets a friction wall, the corner's ghosts
+// mirror ghosts beyond the friction wall: their masses are folded there, and
+// the energy books take each to move as its mirror. Constrained in turn with
+// the mirrors, depth by depth, friction broke that at a fixed wall under the
+// shapes that reach past a wall row (B-splines, GIMP), with friction on
+// either wall; linear shapes and roller walls hold it either way, and guard
+// against its return here.
+template <int Dim>
+std::size_t unmirrored_in_corner(Scheme scheme, ShapeKind shape, Wall::Type mirrored, bool friction_floor) {
+  Grid<Dim> g;
+  if constexpr (Dim == 2)
+    g = grid(2.0, 2.0, 0.1);
+  else
+    g = grid(Vec<3>{1.0, 1.0, 1.0}, 0.1);
+  // A body thrown into the corner of the left wall, the floor and (3D) the back.
+  Particles<Dim> p = block(g, Vec<Dim>::Zero(), Vec<Dim>::Constant(0.5), 1000, 2);
+  Vec<Dim> thrown = Vec<Dim>::Constant(-0.5);
+  thrown[0] = -2.0;
+  thrown[1] = -1.0;
+  for (auto& v : p.v) v = thrown;
+  Settings<Dim> s;
+  s.scheme = scheme;
+  s.shape = shape;
+  s.gravity[1] = -9.81;
+  const Wall friction{Wall::Type::friction, 0.4};
+  s.walls[0] = friction_floor ? Wall{mirrored} : friction;
+  s.walls[2] = friction_floor ? friction : Wall{mirrored};
+  if constexpr (Dim == 3) s.walls[4] = {mirrored};
+  Solver<Dim> solver(g, elastic<Dim>({1000, 1e7, 0.3}), std::move(p), s);
+  std::size_t unmirrored = 0;
+  for (int k = 0; k < 20; ++k) {
+    solver.step(solver.stable_time_step());
+    unmirrored += solver.unmirrored_ghosts();
+  }
+  return unmirrored;
+}
+
+TEST_CASE("where a friction wall meets a fixed or roller one, every ghost moves as its mirror", "[mpm][friction]") {
+  const Scheme scheme = GENERATE(Scheme::usf, Scheme::usl, Scheme::musl);
+  const ShapeKind shape = GENERATE(ShapeKind::linear, ShapeKind::gimp, ShapeKind::bspline);
+  const Wall::Type mirrored = GENERATE(Wall::Type::fixed, Wall::Type::roller);
+  const bool friction_floor = GENERATE(true, false);
+  const char* const schemes[] = {"USF", "USL", "MUSL"};
+  const char* const shapes[] = {"linear", "GIMP", "B-spline"};
+  INFO(schemes[static_cast<int>(scheme)] << ", " << shapes[static_cast<int>(shape)] << ", "
+                                         << (mirrored == Wall::Type::fixed ? "fixed" : "roller")
+                                         << " wall, friction on the " << (friction_floor ? "floor" : "left wall"));
+  CHECK(unmirrored_in_corner<2>(scheme, shape, mirrored, friction_floor) == 0);
+  CHECK(unmirrored_in_corner<3>(scheme, shape, mirrored, friction_floor) == 0);
 }
