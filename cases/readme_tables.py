@@ -524,6 +524,9 @@ for name, written in [
     ("mpm benchmark nodal spread avx2", "compare-a34f189-nodal-spread.csv"),
     ("mpm benchmark nodal spread 63e0ffd avx2", "compare-63e0ffd-nodal-spread-epyc.csv"),
     ("mpm benchmark 3d nodal spread avx2", "compare-3d-a34f189-nodal-spread.csv"),
+    ("mpm benchmark stress check in update avx2", "compare-539371e-stress-in-update.csv"),
+    ("mpm benchmark 3d stress check in update avx2", "compare-3d-539371e-stress-in-update.csv"),
+    ("mpm benchmark stress check 63e0ffd avx2", "compare-63e0ffd-stress-in-update-epyc.csv"),
 ]:
     block(name, "mpm_solid/benchmark/" + written)(mpm_benchmark_builds)
 

@@ -207,10 +207,16 @@ std::string describe(const StepTimes& t);
 struct Census {
   double external_work = 0;
   long bad = 0, escaped = 0, runaway = 0;
+  // Under USF, the particles whose stress the update left non-finite: the
+  // update pass (split, the force scatter after it) checks them while they
+  // are in cache, and bad counts only positions and velocities. Under USL
+  // and MUSL the update comes last and bad counts the stresses too.
+  long bad_stresses = 0;
   double fastest = 0;
   Census& operator+=(const Census& o) {
     external_work += o.external_work;
     bad += o.bad;
+    bad_stresses += o.bad_stresses;
     escaped += o.escaped;
     runaway += o.runaway;
     fastest = std::max(fastest, o.fastest);
@@ -337,10 +343,12 @@ class Solver {
   void step_kernel(double dt);
   template <class Shape, bool Apic>
   void scatter_mass_momentum();
+  // Check: count the particles whose stress is non-finite (USF's split
+  // passes, whose update just wrote them), returned.
+  template <class Shape, bool Check>
+  long scatter_forces();
   template <class Shape>
-  void scatter_forces();
-  template <class Shape>
-  void update_and_scatter(double dt);
+  long update_and_scatter(double dt);  // the particles whose stress it left non-finite
   template <class Shape>
   void gather_velocity_gradient();
   template <class Shape>
@@ -369,7 +377,9 @@ class Solver {
   template <class F>
   void over_ghost_layer(int side, int depth, F&& f) const;
   void update_stresses(double dt);
-  // At most chunk_lanes particles.
+  // At most chunk_lanes particles; Stresses: whether their stresses are
+  // checked here (USL, MUSL) or were where the update wrote them (USF).
+  template <bool Stresses>
   void count(int start, int lanes, double dt, Census& census) const;
   Census move_particles(double dt);
   void remove_escaped(const Census& census, StepInfo& info);

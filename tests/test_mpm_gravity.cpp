@@ -1,9 +1,13 @@
 // Gravity: a column settling to its geostatic stress (and without locking when
-// nearly incompressible), and a step beyond the stable one under it.
+// nearly incompressible), a step beyond the stable one under it, and a stress
+// gone non-finite.
 #include <catch2/catch.hpp>
 
 #include <chrono>
 #include <cmath>
+#include <limits>
+
+#include <fmt/format.h>
 
 #include "common/program.hpp"
 #include "mpm_fixtures.hpp"
@@ -94,6 +98,38 @@ TEST_CASE("a step far beyond the stable one stops the run naming step, particle 
                             (Catch::Contains("velocity") || Catch::Contains("non-finite")));
     std::printf("\nunstable run stopped: %s\n", message.c_str());
   }
+}
+
+// Under USF a stress gone wrong in the update is named, not the positions and
+// velocities its forces then spoil around it (those of lower index first).
+template <int Dim>
+void check_non_finite_stress_named(bool split) {
+  Grid<Dim> gr;
+  if constexpr (Dim == 2)
+    gr = grid(4.0, 4.0, 0.25);
+  else
+    gr = grid(Vec<3>{2, 2, 2}, 0.25);
+  Settings<Dim> s;
+  s.gravity[1] = -9.81;
+  s.walls[2] = {Wall::Type::fixed};
+  s.smooth_dilatation = split;  // the split passes: gather, smoothing, update, forces
+  Vec<Dim> lo = Vec<Dim>::Constant(0.5), hi = Vec<Dim>::Constant(1.5);
+  Particles<Dim> p = block(gr, lo, hi, 1000, 2);
+  // The last particle: the first ones in memory see its forces' NaN first.
+  const std::size_t broken = p.size() - 1;
+  p.stress[broken](0, Dim - 1) = std::numeric_limits<double>::quiet_NaN();
+  Solver<Dim> solver(gr, elastic<Dim>({1000, 1e7, 0.3}), std::move(p), s);
+  const int id = solver.particles().id[broken];
+  CHECK_THROWS_WITH(solver.step(solver.stable_time_step()),
+                    Catch::Contains("mpm: step 1 ") && Catch::Contains(fmt::format("particle {} ", id)) &&
+                        Catch::Contains("non-finite stress"));
+}
+
+TEST_CASE("a non-finite stress stops the step naming it and its particle", "[mpm][robust]") {
+  const bool split = GENERATE(false, true);
+  INFO((split ? "split passes" : "fused pass"));
+  SECTION("2D") { check_non_finite_stress_named<2>(split); }
+  SECTION("3D") { check_non_finite_stress_named<3>(split); }
 }
 
 TEST_CASE("the steps' wall time is booked to their parts, in every scheme", "[mpm]") {
