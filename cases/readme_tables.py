@@ -597,12 +597,13 @@ def mpm_benchmark(rows):
 
 
 # mpm-benchmark's own CSVs from the AVX2 processor of "The same builds on another processor": before the
-# plastic rows' yield check over lanes, after it, after the gathers' node pairs and after the
-# transfer's spread over the nodes.
+# plastic rows' yield check over lanes, after it, after the gathers' node pairs, after the
+# transfer's spread over the nodes and after the census's stress check moved into the update.
 for name, written in [("mpm benchmark avx2", "mpm-benchmark-avx2.csv"),
                       ("mpm benchmark avx2 screen", "mpm-benchmark-avx2-screen.csv"),
                       ("mpm benchmark avx2 pairs", "mpm-benchmark-avx2-pairs.csv"),
-                      ("mpm benchmark avx2 nodal spread", "mpm-benchmark-avx2-nodal.csv")]:
+                      ("mpm benchmark avx2 nodal spread", "mpm-benchmark-avx2-nodal.csv"),
+                      ("mpm benchmark avx2 stress check in update", "mpm-benchmark-avx2-stress.csv")]:
     block(name, "mpm_solid/benchmark/" + written)(mpm_benchmark)
 
 
