@@ -527,6 +527,7 @@ for name, written in [
     ("mpm benchmark stress check in update avx2", "compare-539371e-stress-in-update.csv"),
     ("mpm benchmark 3d stress check in update avx2", "compare-3d-539371e-stress-in-update.csv"),
     ("mpm benchmark stress check 63e0ffd avx2", "compare-63e0ffd-stress-in-update-epyc.csv"),
+    ("mpm benchmark weights only avx2", "compare-03d1898-weights-only.csv"),
 ]:
     block(name, "mpm_solid/benchmark/" + written)(mpm_benchmark_builds)
 
