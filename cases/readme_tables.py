@@ -528,6 +528,7 @@ for name, written in [
     ("mpm benchmark 3d stress check in update avx2", "compare-3d-539371e-stress-in-update.csv"),
     ("mpm benchmark stress check 63e0ffd avx2", "compare-63e0ffd-stress-in-update-epyc.csv"),
     ("mpm benchmark weights only avx2", "compare-03d1898-weights-only.csv"),
+    ("mpm benchmark stencil cache avx2", "compare-03d1898-stencil-cache.csv"),
     ("mpm benchmark no books 63e0ffd avx2", "compare-63e0ffd-no-books-epyc.csv"),
 ]:
     block(name, "mpm_solid/benchmark/" + written)(mpm_benchmark_builds)
