@@ -239,13 +239,13 @@ void refuse_in_lean_build(bool named, const char* what) {
     throw std::invalid_argument(fmt::format("this build (OUTBURST_MPM_LEAN) has no {}", what));
 }
 
+// Fixed and roller walls mirror their ghost nodes (fold_ghosts, apply_walls).
+bool mirrors(Wall::Type type) { return type == Wall::Type::fixed || type == Wall::Type::roller; }
+
 // A wall condition at one node; n is the unit normal pointing into the wall.
 // Friction walls act only on nodes moving into them: the normal velocity is
 // removed and the tangential one reduced by mu times that change. Returns the
 // work done by friction (fixed and roller walls do none: the wall does not move).
-// Fixed and roller walls mirror their ghost nodes (fold_ghosts, apply_walls).
-bool mirrors(Wall::Type type) { return type == Wall::Type::fixed || type == Wall::Type::roller; }
-
 template <int Dim>
 double constrain(Vec<Dim>& v, const Vec<Dim>& n, const Wall& wall, double mass) {
   const double vn = v.dot(n);
