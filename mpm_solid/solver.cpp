@@ -76,14 +76,6 @@ struct Scatter {
   }
 };
 
-// scripts/unnamed-effects-benchmark.sh compares the full build with one
-// compiled without gravity, loads and pore pressure (OUTBURST_MPM_LEAN).
-#ifdef OUTBURST_MPM_LEAN
-constexpr bool lean_build = true;
-#else
-constexpr bool lean_build = false;
-#endif
-
 // Which form the gathers' node loops take (mpm_solid/gathers.hpp; CMake's
 // OUTBURST_GATHER picks it for the build).
 #ifdef OUTBURST_GATHER_PAIRS
@@ -176,9 +168,8 @@ struct ForceTerms {
 template <int Dim>
 ForceTerms<Dim> force_terms(const Particles<Dim>& p, const Settings<Dim>& settings) {
   const Vec<Dim> g = settings.gravity;
-  const bool loads = !lean_build && !p.external_force.empty();
-  return {g, lean_build || p.pore_pressure.empty() ? nullptr : p.pore_pressure.data(), loads,
-          !lean_build && (loads || g.squaredNorm() > 0)};
+  const bool loads = !p.external_force.empty();
+  return {g, p.pore_pressure.empty() ? nullptr : p.pore_pressure.data(), loads, loads || g.squaredNorm() > 0};
 }
 
 // Adds the internal and body forces of the particles of a chunk's lanes
@@ -232,11 +223,6 @@ template <int Dim, class Shape, int Width, class Particle>
     add_forces(p, t, particle, s, lane, end, f);
     lane = end;
   }
-}
-
-void refuse_in_lean_build(bool named, const char* what) {
-  if (lean_build && named)
-    throw std::invalid_argument(fmt::format("this build (OUTBURST_MPM_LEAN) has no {}", what));
 }
 
 // Fixed and roller walls mirror their ghost nodes (fold_ghosts, apply_walls).
@@ -403,8 +389,6 @@ Solver<Dim>::Solver(Grid<Dim> grid, std::vector<std::unique_ptr<Material<Dim>>> 
   double total_mass = 0;
   for (double m : particles_.mass) total_mass += m;
   empty_node_mass_ = settings_.empty_node_mass_fraction * total_mass / static_cast<double>(particles_.size());
-  refuse_in_lean_build(settings_.gravity.squaredNorm() > 0, "gravity");
-  refuse_in_lean_build(!particles_.surface_force.empty(), "tractions");
   rebuild_material_groups();
   for (std::size_t m = 0; m < materials_.size(); ++m) materials_[m]->create_fields(particles_, members_[m]);
   find_obstacle_nodes();
@@ -1140,7 +1124,7 @@ template <bool Stresses>
       if (finite & inside & !fast & (speed > fastest)) fastest = speed;
     }
   };
-  const bool pore = !lean_build && !p.pore_pressure.empty() && !p.velocity_gradient.empty();
+  const bool pore = !p.pore_pressure.empty() && !p.velocity_gradient.empty();
   with_draws(p, [&](auto drawn) __attribute__((always_inline)) {
     if (pore)
       over_lanes(std::true_type{}, drawn);
@@ -1167,7 +1151,7 @@ void Solver<Dim>::gather_motion(double dt) {
   const double flip = settings_.flip_fraction;
   Census census;
   double lost = 0, work = 0;
-  const bool loads = !lean_build && !p.external_force.empty();
+  const bool loads = !p.external_force.empty();
   // The new velocities and positions of particles start .. start + lanes - 1
   // from what their stencils gathered (lane by lane: v_pic, dv and, under
   // APIC, affine), the energy books and, under Move, the census; the calling
@@ -1477,14 +1461,12 @@ StepInfo Solver<Dim>::step(double dt) {
 
 template <int Dim>
 std::vector<Vec<Dim>>& Solver<Dim>::external_force() {
-  refuse_in_lean_build(true, "external forces");
   particles_.need_loads();
   return particles_.external_force;
 }
 
 template <int Dim>
 std::vector<double>& Solver<Dim>::pore_pressure() {
-  refuse_in_lean_build(true, "pore pressure");
   particles_.need_pore_pressure();
   return particles_.pore_pressure;
 }

@@ -6,11 +6,6 @@
 // released under gravity onto a fixed floor, so that every step does real
 // work (moving particles, changing stresses).
 // Usage: mpm-benchmark [particles ...] [--csv FILE] [--shape S ...] [--material M ...] [--threads T ...]
-//        mpm-benchmark --unloaded [particles]   (--help says more)
-// --unloaded: one line, the throughput of an elastic block spinning free of
-// gravity and loads: what scripts/unnamed-effects-benchmark.sh compares between
-// the full build and one without gravity, loads and pore pressure
-// (OUTBURST_MPM_LEAN).
 #include <omp.h>
 
 #include <chrono>
@@ -41,42 +36,6 @@ const char* model_name(Model m) {
 }
 const char* shape_name(ShapeKind s) {
   return s == ShapeKind::linear ? "linear" : s == ShapeKind::gimp ? "gimp" : "bspline";
-}
-
-double unloaded_particle_steps_per_second(long particles) {
-  omp_set_num_threads(1);
-  const int per_cell = 2;
-  const int side = static_cast<int>(std::lround(std::sqrt(static_cast<double>(particles)) / per_cell));
-  Grid<2> g;
-  g.h = 1.0;
-  g.lower = {0, 0};
-  g.cells = {side * 2, side * 2};
-  g.upper = {g.cells[0] * g.h, g.cells[1] * g.h};
-  std::vector<Vec<2>> points;
-  const Vec<2> centre(side, side);
-  fill_cells<2>(g, per_cell, centre.array() - side / 2.0, centre.array() + side / 2.0,
-             [](const Vec<2>&) { return true; }, points);
-  Particles<2> p;
-  const double volume = 1.0 / (per_cell * per_cell);
-  for (const auto& x : points) {
-    const Vec<2> r = x - centre;
-    p.add(x, 0.01 * Vec<2>(-r.y(), r.x()), 1600 * volume, volume, 0.5 / per_cell, Mat<2>::Zero(), 0, 0);
-  }
-  std::vector<std::unique_ptr<Material<2>>> materials;
-  materials.push_back(std::make_unique<LinearElastic<2>>("coal", Elasticity{1600, 6e7, 0.3}));
-  Solver<2> solver(g, std::move(materials), std::move(p), Settings<2>{});
-  const double dt = solver.stable_time_step();
-  const long n = static_cast<long>(solver.particles().size());
-  for (int i = 0; i < 3; ++i) solver.step(dt);
-  const int steps = static_cast<int>(std::max(5L, 10000000L / n));
-  double best = 0;
-  for (int repeat = 0; repeat < 5; ++repeat) {
-    const auto start = std::chrono::steady_clock::now();
-    for (int i = 0; i < steps; ++i) solver.step(dt);
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    best = std::max(best, static_cast<double>(n) * steps / seconds);
-  }
-  return best;
 }
 
 struct Measured {
@@ -154,7 +113,6 @@ int main(int argc, char** argv) {
   std::string csv_path;
   const int cores = omp_get_max_threads();
   std::vector<int> thread_counts{1, std::min(2, cores)};
-  bool unloaded = false;
   int dimension = 2;
   app.add_option("particles", sizes, "particles of each row's block (at least 100; 1e5 is read)")
       ->check(CLI::Range(100.0, 1e9))
@@ -180,9 +138,6 @@ int main(int argc, char** argv) {
                  "2: plane strain (2 x 2 particles per cell); 3: 3D (2 x 2 x 2 per cell, a cube of them)")
       ->check(CLI::IsMember({2, 3}))
       ->capture_default_str();
-  app.add_flag("--unloaded", unloaded,
-               "one number: an elastic block spinning free of gravity and loads (B-splines, 1 thread, best of 5; "
-               "scripts/unnamed-effects-benchmark.sh), of the first particle count (default 1e5)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -193,15 +148,6 @@ int main(int argc, char** argv) {
   std::vector<Model> models;
   for (const auto& name : shape_names) shapes.push_back(shape_words.at(name));
   for (const auto& name : model_names) models.push_back(model_words.at(name));
-  if (unloaded) {
-    if (dimension != 2) {
-      std::fprintf(stderr, "mpm-benchmark: --unloaded measures the plane block; leave --dimension out\n");
-      return 2;
-    }
-    const bool given = app.count("particles") > 0;
-    std::printf("%.6e\n", unloaded_particle_steps_per_second(given ? std::lround(sizes.front()) : 100000));
-    return 0;
-  }
   std::FILE* csv = nullptr;
   if (!csv_path.empty()) {
     // The CSV's columns are one and two threads (README.md's table).
