@@ -3,17 +3,22 @@
 // strain (Dim = 2, quantities per metre of depth) or 3D (Dim = 3), one code.
 //
 // One step (update-stress-first, the paper's section 3; USL and MUSL move the
-// stress update after the grid update):
+// stress update after the grid update), each pass in a file of passes/:
 //   1. particles -> grid: mass and momentum (under USF with the FLIP/PIC
-//      blend, mapped by the last step's 6, unless the particles changed since)
-//   2. grid velocities, walls applied
-//   3. grid -> particles: velocity gradient; materials update stress (Jaumann)
-//   4. particles -> grid: internal force, gravity, external forces
-//   5. grid momentum update, walls applied
+//      blend, mapped by the last step's 6, unless the particles changed
+//      since)                                                scatter.cpp
+//   2. grid velocities, walls applied                      grid_update.cpp
+//   3. grid -> particles: velocity gradient; materials update stress
+//      (Jaumann)                                     stress_and_forces.cpp
+//   4. particles -> grid: internal force, gravity, external forces (ditto)
+//   5. grid momentum update, walls applied        grid_update.cpp, walls.cpp
 //   6. grid -> particles: velocity (FLIP/PIC blend) and position
+//      (motion.cpp), and the census of what moved (census.cpp)
 // The shape function and the update scheme are compiled into the step: the
-// solver picks one specialised kernel at construction, so neither costs a
-// branch per particle.
+// solver picks one specialised kernel at construction (solver.cpp), so
+// neither costs a branch per particle. energy_books.cpp keeps the books,
+// solver_state.cpp the state a checkpoint holds. docs/theory/mpm.md derives
+// the step.
 
 #include <algorithm>
 #include <array>
@@ -25,162 +30,17 @@
 #include <vector>
 
 #include "mpm_solid/active_blocks.hpp"
+#include "mpm_solid/energy_books.hpp"
 #include "mpm_solid/grid.hpp"
 #include "mpm_solid/material.hpp"
 #include "mpm_solid/particles.hpp"
+#include "mpm_solid/settings.hpp"
 
 namespace outburst::mpm {
-
-enum class Scheme { usf, usl, musl };
-enum class ShapeKind { linear, gimp, bspline };
-
-// Cells a crack's strain spreads over: a jump in nodal velocity between two
-// nodes strains the one cell between them under linear shapes, and under GIMP
-// too while the particles' domains tile the cells (none reaches into its
-// neighbour's cell); under quadratic B-splines the gradient of the jump is a
-// tent two cells wide, and every particle under it breaks as the crack opens.
-// A crack band is as wide as this (tests/test_mpm_fracture.cpp measures it).
-constexpr int crack_cells(ShapeKind shape) { return shape == ShapeKind::bspline ? 2 : 1; }
-
-struct Wall {
-  enum class Type { open, fixed, roller, friction };
-  Type type = Type::open;
-  double friction = 0;  // Coulomb coefficient (friction walls)
-};
-
-// A rigid, fixed rectangle (a box in 3D) inside the grid (the tunnel's roof
-// and floor rock, a support): grid nodes inside it or on its faces take its
-// contact condition, with the normal of the nearest face. Faces on grid lines
-// act exactly there; others act up to a cell inside the obstacle.
-// A support holds material only while it settles (the unexcavated face): the
-// dynamic stage starts without it.
-template <int Dim>
-struct Obstacle {
-  Vec<Dim> lower, upper;
-  Wall contact{Wall::Type::friction, 0};
-  bool support = false;
-};
-
-// A rigid, massless, frictionless loading plate: the grid nodes in its box move
-// together along `axis`, pushed by `force` and by what the material beneath
-// pushes back; across that axis they move freely. Unlike a traction, the load
-// shifts toward the stiffer part of the body as it deforms (Mandel's problem).
-template <int Dim>
-struct Platen {
-  Vec<Dim> lower, upper;
-  int axis = 1;
-  double force = 0;  // along axis [N; N/m in 2D, per metre of depth]
-  // Set: the plate moves at this speed along axis [m/s] whatever it takes
-  // (displacement control, which can follow a load past its peak); `force`
-  // is then unused.
-  std::optional<double> velocity;
-};
-
-// The quasi-static stage before t = 0: in-situ stress and gravity brought to
-// equilibrium with local damping, supports in place.
-struct Settling {
-  double duration = 0;  // [s]; 0: no stage
-  double damping = 0.8;
-};
-
-template <int Dim>
-struct Settings {
-  Scheme scheme = Scheme::usf;
-  // Quadratic B-splines by default: C1 gradients (no cell-crossing noise when
-  // particles travel far) and the most accurate in the tests.
-  ShapeKind shape = ShapeKind::bspline;
-  // Velocity transfer: FLIP/PIC blend (1: pure FLIP, 0: pure PIC), or APIC
-  // (affine particle-in-cell: PIC plus a velocity gradient per particle, which
-  // conserves angular momentum without FLIP's noise).
-  bool apic = false;
-  double flip_fraction = 0.99;
-  double courant = 0.3;
-  Vec<Dim> gravity = Vec<Dim>::Zero();
-  // Local (Cundall) damping coefficient for quasi-static stages: each nodal
-  // force component loses alpha |f| against the node's motion. 0: off.
-  double local_damping = 0;
-  // Mass-proportional viscous damping c [1/s]: nodal force -c m v, taken
-  // implicitly (stable for any c). Linear and smooth in the state, unlike the
-  // local damping's sign switch: what an iterated coupling of a quasi-static
-  // solid needs. 0: off.
-  double viscous_damping = 0;
-  // left, right, bottom, top (and in 3D back, front) of the physical domain:
-  // the low and high face along each axis in turn
-  std::array<Wall, 2 * Dim> walls;
-  std::vector<Obstacle<Dim>> obstacles;
-  std::vector<Platen<Dim>> platens;
-  // Volumetric-locking remedy: replace each particle's dilatation rate tr(L) by
-  // its volume-weighted average mapped to the nodes and back (nodal dilatation
-  // smoothing), leaving the deviatoric rate alone. Near-incompressible
-  // elasticity and plastic flow otherwise lock and checkerboard.
-  bool smooth_dilatation = false;
-  // Nodes lighter than this fraction of the mean particle mass are treated as
-  // empty (no velocity): they would turn a finite force into a huge one.
-  double empty_node_mass_fraction = 1e-6;
-};
 
 class SimulationError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
-};
-
-// Energies [J; J/m in 2D, per metre of depth]. Stored ones are computed from the current
-// state; dissipated and external ones accumulate over the run. With the
-// gravitational potential measured from the grid's lower edge,
-//   kinetic + strain + gravity + plastic + damage + damping + walls + transfer
-//   + integration + left - external
-// stays constant but for the balance error. The two numerical terms:
-// `transfer`, the kinetic energy the grid-to-particle transfer takes from
-// what the grid's update gave (the velocity increment, interpolated, is
-// smoother than on the nodes; a PIC share or APIC also replaces the
-// particles' sub-cell velocity differences with the grid's field), and
-// `integration`, what the explicit step itself took (negative: gave): the
-// work of the grid's update along the grid's velocities against the change of
-// the stored, dissipated and external energies it should equal; it falls
-// with the time step. `walls` is the work of wall friction and what walls and
-// platens take from the mapped momenta; `left` what particles carried off the
-// grid. The balance error is then round-off, unless a velocity changes where
-// no book sees it.
-struct Energies {
-  double kinetic = 0, strain = 0, gravity = 0;
-  double plastic = 0, damage = 0, damping = 0, walls = 0;  // dissipated so far
-  double transfer = 0;                                     // lost in grid-to-particle transfers so far
-  double integration = 0;                                  // taken by the explicit step so far
-  double left = 0;                                         // carried off by particles that left the grid
-  double external = 0;                                     // work of the external forces so far
-  // The books behind `integration`: the kinetic energy the grid's update gave
-  // pure FLIP particles before the transfer, the kinetic share of `left`, and
-  // the strain and gravitational energy when the books opened.
-  double grid_work = 0, left_kinetic = 0, stored_start = 0;
-  double total() const {
-    return kinetic + strain + gravity + plastic + damage + damping + walls + transfer + integration + left -
-           external;
-  }
-  void save(checkpoint::Out out, const std::string& name) const;
-  static Energies load(const checkpoint::In& in, const std::string& name);
-};
-
-// Whether a run's energy books close: over the states recorded, the largest
-// balance error against the largest change of any term (the stored energies'
-// changes from the first state, the dissipated and external ones' totals).
-class EnergyAudit {
- public:
-  void record(const Energies& e, double time);
-  // Largest |balance error| over the largest term; 0 before two records.
-  double open_share() const { return largest_term_ > 0 ? worst_error_ / largest_term_ : 0.0; }
-  // The balance error of the last state recorded over the largest term.
-  double final_share() const { return largest_term_ > 0 ? last_error_ / largest_term_ : 0.0; }
-  // Largest |integration| over the largest term: the step's own error, which
-  // a step near the stable limit, or a run going unstable, drives up.
-  double integration_share() const { return largest_term_ > 0 ? worst_integration_ / largest_term_ : 0.0; }
-  double largest_term() const { return largest_term_; }
-  double worst_time() const { return worst_time_; }
-  void save(checkpoint::Out out) const;
-  void load(const checkpoint::In& in);
-
- private:
-  std::optional<Energies> first_;
-  double largest_term_ = 0, worst_error_ = 0, worst_time_ = 0, last_error_ = 0, worst_integration_ = 0;
 };
 
 struct StepInfo {
@@ -355,12 +215,25 @@ class Solver {
   void smooth_dilatation();
   template <class Shape, bool Apic, bool Move>
   void gather_motion(double dt);
+  // gather_motion's two transfers; the calling thread's census and sums.
+  template <class Shape, bool Move>
+  void gather_affine_motion(double dt, Census& census, double& lost, double& work);
+  template <class Shape, bool Move>
+  void gather_blended_motion(double dt, Census& census, double& lost, double& work);
   void grid_velocities();
   void grid_update(double dt);
   double apply_walls(std::vector<Vec<Dim>>& velocity) const;
+  // apply_walls' obstacles (their friction's work added to friction_work) and
+  // ghost rows beyond fixed and roller walls.
+  void constrain_obstacles(std::vector<Vec<Dim>>& velocity, double& friction_work) const;
+  void mirror_ghosts(std::vector<Vec<Dim>>& velocity) const;
   void apply_platens(std::vector<Vec<Dim>>& velocity, double impulse, double dt);
+  using Kernel = void (Solver::*)(double);
+  Kernel pick_kernel() const;
+  void create_grid_fields();
   void create_transfer_fields();
   void find_obstacle_nodes();
+  void find_platen_nodes();
   void remove_supports();  // the settling stage is over
   // Folds what the particles gave the ghost nodes beyond fixed and roller
   // walls into their mirrors inside (mass, if given, and vectors), and calls
@@ -389,7 +262,7 @@ class Solver {
   std::vector<std::unique_ptr<Material<Dim>>> materials_;
   Particles<Dim> particles_;
   Settings<Dim> settings_;
-  void (Solver::*kernel_)(double) = nullptr;
+  Kernel kernel_ = nullptr;
   // Every particle's stress update reads only its own fields, and no
   // smoothing of the dilatation runs between the gather and the update: USF
   // fuses them with the force scatter (update_and_scatter).
