@@ -22,6 +22,7 @@
 #include "mpm_solid/materials/drucker_prager.hpp"
 #include "mpm_solid/materials/elastic.hpp"
 #include "mpm_solid/materials/elastic_damage.hpp"
+#include "mpm_solid/materials/elastic_point.hpp"
 #include "mpm_solid/scene_reader.hpp"
 #include "mpm_solid/solver.hpp"
 
@@ -30,9 +31,18 @@ using namespace outburst::mpm;
 
 namespace {
 
-enum class Model { elastic, drucker_prager, elastic_damage };
+// elastic_point: the elastic law written per material point
+// (mpm_solid/materials/elastic_point.hpp), whose row against elastic's is
+// what the per-point adapter costs.
+enum class Model { elastic, elastic_point, drucker_prager, elastic_damage };
 const char* model_name(Model m) {
-  return m == Model::elastic ? "elastic" : m == Model::drucker_prager ? "drucker_prager" : "elastic_damage";
+  switch (m) {
+    case Model::elastic: return "elastic";
+    case Model::elastic_point: return "elastic_point";
+    case Model::drucker_prager: return "drucker_prager";
+    case Model::elastic_damage: return "elastic_damage";
+  }
+  return "";
 }
 const char* shape_name(ShapeKind s) {
   return s == ShapeKind::linear ? "linear" : s == ShapeKind::gimp ? "gimp" : "bspline";
@@ -74,6 +84,7 @@ Measured measure(long particles, ShapeKind shape, Model model, int threads) {
   std::vector<std::unique_ptr<Material<Dim>>> materials;
   switch (model) {
     case Model::elastic: materials.push_back(std::make_unique<LinearElastic<Dim>>("coal", e)); break;
+    case Model::elastic_point: materials.push_back(elastic_point<Dim>("coal", e)); break;
     case Model::drucker_prager:
       materials.push_back(
           std::make_unique<DruckerPrager<Dim>>("coal", e, 1e4, 0.5, 0.0, DruckerPragerFit::Kind::outer));
@@ -122,7 +133,10 @@ int main(int argc, char** argv) {
   const std::map<std::string, ShapeKind> shape_words{
       {"linear", ShapeKind::linear}, {"gimp", ShapeKind::gimp}, {"bspline", ShapeKind::bspline}};
   const std::map<std::string, Model> model_words{
-      {"elastic", Model::elastic}, {"drucker_prager", Model::drucker_prager}, {"elastic_damage", Model::elastic_damage}};
+      {"elastic", Model::elastic},
+      {"elastic_point", Model::elastic_point},
+      {"drucker_prager", Model::drucker_prager},
+      {"elastic_damage", Model::elastic_damage}};
   std::vector<std::string> shape_names{"linear", "bspline"}, model_names{"elastic", "drucker_prager", "elastic_damage"};
   app.add_option("--shape", shape_names, "the shape functions measured")
       ->check(CLI::IsMember(shape_words))
