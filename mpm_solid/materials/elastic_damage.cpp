@@ -16,102 +16,10 @@
 #include <Eigen/Eigenvalues>
 #include <fmt/format.h>
 
+#include "mpm_solid/materials/principal.hpp"
 #include "mpm_solid/nonlocal.hpp"
 
 namespace outburst::mpm {
-
-namespace {
-
-// Open cracks: tensile principal parts scaled by (1 - D) (or back, by 1/(1 - D)).
-double crack(double principal_value, double factor) {
-  return principal_value > 0 ? factor * principal_value : principal_value;
-}
-
-// The principal decomposition of a stress matrix (the in-plane one under
-// plane strain), and the stress whose tensile principal parts are scaled.
-template <int Dim>
-struct Principal;
-
-template <>
-struct Principal<2> {
-  double a, b;          // a >= b
-  double cos, sin;      // the direction of a
-  // Straight-line code, both cases computed and one chosen, as are the
-  // damage law's: the plane's update runs them over SIMD lanes.
-  Principal(double xx, double yy, double xy) {
-    const double centre = 0.5 * (xx + yy);
-    const double half = 0.5 * (xx - yy);
-    const double radius = std::sqrt(half * half + xy * xy);
-    // Half-angle formulas from cos 2t = half / radius, sin 2t = s_xy / radius:
-    // no trigonometric calls in the innermost loop of the damage law. Where
-    // the squares fall below the normal numbers (entries under 1e-154, as a
-    // grid's round-off spreads through a body at rest) the radius keeps few
-    // bits and may come out below |half|: cos 2t is held to [-1, 1], else the
-    // half-angle roots turned NaN and the body with them. Above, the radius
-    // is never below |half| and the bound changes nothing. By value, as the
-    // yield screen's maxima are (drucker_prager.cpp: std::max's references
-    // became masked loads there, which kept its lanes scalar).
-    const double ratio = half / radius;
-    const double cos2 = ratio > 1 ? 1.0 : (ratio < -1 ? -1.0 : ratio);
-    const bool equal = radius == 0;  // any direction is principal
-    a = equal ? centre : centre + radius;
-    b = equal ? centre : centre - radius;
-    const double c = std::sqrt(0.5 * (1 + cos2)), s = std::copysign(std::sqrt(0.5 * (1 - cos2)), xy);
-    cos = equal ? 1.0 : c;
-    sin = equal ? 0.0 : s;
-  }
-  explicit Principal(const Mat<2>& s) : Principal(s(0, 0), s(1, 1), s(0, 1)) {}
-  double largest() const { return a; }
-  double smallest() const { return b; }
-  double sum() const { return a + b; }
-  // The entries in Eigen's column-major order, each as Eigen formed
-  // (crack(a) direction) direction^T + (crack(b) normal) normal^T.
-  void cracked(double factor, double& xx, double& yx, double& xy, double& yy) const {
-    const double ca = crack(a, factor), cb = crack(b, factor), nx = -sin, ny = cos;
-    const double t0 = ca * cos, t1 = ca * sin, u0 = cb * nx, u1 = cb * ny;
-    xx = t0 * cos + u0 * nx;
-    yx = t1 * cos + u1 * nx;
-    xy = t0 * sin + u0 * ny;
-    yy = t1 * sin + u1 * ny;
-  }
-  void cracked(double factor, double* out) const { cracked(factor, out[0], out[1], out[2], out[3]); }
-  Mat<2> cracked(double factor) const {
-    Mat<2> m;
-    cracked(factor, m.data());
-    return m;
-  }
-};
-
-template <>
-struct Principal<3> {
-  Mat<3> matrix;
-  Vec<3> values;  // ascending
-  Mat<3> axes;    // the columns; only where the values straddle zero
-  explicit Principal(const Mat<3>& s) : matrix(s) {
-    // A state all in tension, or all in compression, cracks without its
-    // axes. Where they are needed, the iterative solver's: the closed form's
-    // are not orthogonal where two principal values agree (by 7e-7 under
-    // uniaxial strain, its two lateral stresses equal), and the stress
-    // recomposed from them is off by as much.
-    Eigen::SelfAdjointEigenSolver<Mat<3>> solver;
-    solver.computeDirect(s, Eigen::EigenvaluesOnly);
-    values = solver.eigenvalues();
-    if (values[0] < 0 && values[2] > 0) {
-      solver.compute(s);
-      values = solver.eigenvalues();
-      axes = solver.eigenvectors();
-    }
-  }
-  Mat<3> cracked(double factor) const {
-    if (values[0] >= 0) return factor * matrix;
-    if (values[2] <= 0) return matrix;
-    Vec<3> v;
-    for (int k = 0; k < 3; ++k) v[k] = crack(values[k], factor);
-    return axes * v.asDiagonal() * axes.transpose();
-  }
-};
-
-}  // namespace
 
 double largest_band_width(const DamageParameters& d, const Elasticity& e) {
   return d.fracture_energy ? 2 * e.youngs_modulus * *d.fracture_energy / (d.tensile_strength * d.tensile_strength)
@@ -419,6 +327,45 @@ Dissipation ElasticDamage<Dim>::update_alone(Particles<Dim>& p, int i) const {
   return settle(p, i, damage(p.damage[i], st, strength_scale(p, i), stiffness), st);
 }
 
+namespace {
+
+// settle's friction for one lane of settle_plane: drucker_prager_return with
+// no dilation, as written there (Eigen's deviator s - mean I and stress mean
+// I + ratio deviator entry by entry, and the squared norm's pairs as its
+// packets sum them), of the acting stress s (Eigen's column-major order)
+// with moduli g and bulk and the cone's alpha and cohesion.
+struct PlaneReturn {
+  double sum, f;                     // the trial's I1 and yield function
+  double r00, r10, r01, r11, r_zz;   // the stress returned to the cone
+  double work, multiplier;           // plastic work density, plastic multiplier
+};
+
+[[gnu::always_inline]] inline PlaneReturn plane_friction_return(double s0, double s1, double s2, double s3,
+                                                                double s_zz, double g, double bulk, double alpha,
+                                                                double cohesion) {
+  const double sum = s0 + s3 + s_zz, mean = sum / 3;
+  const double d00 = s0 - mean * 1.0, d10 = s1 - mean * 0.0, d01 = s2 - mean * 0.0, d11 = s3 - mean * 1.0;
+  const double d_zz = s_zz - mean;
+  const double squared = (d00 * d00 + d01 * d01) + (d10 * d10 + d11 * d11);
+  const double sqrt_j2 = std::sqrt(0.5 * (squared + d_zz * d_zz));
+  const double f = alpha * mean + sqrt_j2 - cohesion;
+  const double along = f / (g + bulk * alpha * 0.0);
+  const double shrunk = sqrt_j2 - g * along;
+  // A return that overshoots the cone's tip ends at the tip, as
+  // drucker_prager_return's does.
+  const double to_mean = shrunk < 0 ? cohesion / alpha : mean - bulk * 0.0 * along;
+  const double to_sqrt_j2 = shrunk < 0 ? 0.0 : shrunk;
+  const double multiplier = shrunk < 0 ? sqrt_j2 / g : along;
+  const double quotient = to_sqrt_j2 / sqrt_j2, ratio = sqrt_j2 > 0 ? quotient : 0.0;
+  const double r00 = to_mean * 1.0 + ratio * d00, r10 = to_mean * 0.0 + ratio * d10,
+               r01 = to_mean * 0.0 + ratio * d01, r11 = to_mean * 1.0 + ratio * d11;
+  const double r_zz = to_mean + ratio * d_zz;
+  const double work = to_sqrt_j2 * (sqrt_j2 - to_sqrt_j2) / g + to_mean * (mean - to_mean) / bulk;
+  return {sum, f, r00, r10, r01, r11, r_zz, work, multiplier};
+}
+
+}  // namespace
+
 // Most of the coal, most of the time, does not crack further: settling then
 // sets its acting stress, returns a compressive one that lies beyond the
 // friction cone to it (the sliding of broken coal) and caps a broken
@@ -471,49 +418,29 @@ Dissipation ElasticDamage<Dim>::settle_plane(Particles<Dim>& p, std::span<const 
     double s0, s1, s2, s3;  // Eigen's column-major order
     pr.cracked(1 - d, s0, s1, s2, s3);
     const double s_zz = crack(zz, 1 - d);
-    // settle's friction: drucker_prager_return with no dilation, as written
-    // there (Eigen's deviator s - mean I and stress mean I + ratio deviator
-    // entry by entry, and the squared norm's pairs as its packets sum them).
     const double g = stiffness * shear, bulk = stiffness * lame + 2.0 / 3.0 * g;
     const double cohesion = (1 - d) * scale * k0;
-    const double sum = s0 + s3 + s_zz, mean = sum / 3;
-    const double d00 = s0 - mean * 1.0, d10 = s1 - mean * 0.0, d01 = s2 - mean * 0.0, d11 = s3 - mean * 1.0;
-    const double d_zz = s_zz - mean;
-    const double squared = (d00 * d00 + d01 * d01) + (d10 * d10 + d11 * d11);
-    const double sqrt_j2 = std::sqrt(0.5 * (squared + d_zz * d_zz));
-    const double f = alpha * mean + sqrt_j2 - cohesion;
-    const double along = f / (g + bulk * alpha * 0.0);
-    const double shrunk = sqrt_j2 - g * along;
-    // A return that overshoots the cone's tip ends at the tip, as
-    // drucker_prager_return's does.
-    const double to_mean = shrunk < 0 ? cohesion / alpha : mean - bulk * 0.0 * along;
-    const double to_sqrt_j2 = shrunk < 0 ? 0.0 : shrunk;
-    const double multiplier = shrunk < 0 ? sqrt_j2 / g : along;
-    const double quotient = to_sqrt_j2 / sqrt_j2, ratio = sqrt_j2 > 0 ? quotient : 0.0;
-    const double r00 = to_mean * 1.0 + ratio * d00, r10 = to_mean * 0.0 + ratio * d10,
-                 r01 = to_mean * 0.0 + ratio * d01, r11 = to_mean * 1.0 + ratio * d11;
-    const double r_zz = to_mean + ratio * d_zz;
-    const double work = to_sqrt_j2 * (sqrt_j2 - to_sqrt_j2) / g + to_mean * (mean - to_mean) / bulk;
+    const PlaneReturn r = plane_friction_return(s0, s1, s2, s3, s_zz, g, bulk, alpha, cohesion);
     // The undamaged stress the return carries back to (same principal axes).
-    const Principal<2> back(r00, r11, r01);
+    const Principal<2> back(r.r00, r.r11, r.r01);
     const double inverse = 1 / (1 - d), open = d < 1 ? inverse : 0.0;
     double e0, e1, e2, e3;
     back.cracked(open, e0, e1, e2, e3);
-    const double slides = d == previous ? (sum < 0 ? (f > 0 ? 1.0 : 0.0) : 0.0) : 0.0;
+    const double slides = d == previous ? (r.sum < 0 ? (r.f > 0 ? 1.0 : 0.0) : 0.0) : 0.0;
     verdict[k] = d == previous ? 1.0 + slides : 0.0;
-    plastic[k] = slides != 0 ? volume[i] * work : 0.0;
-    plastic_strain[i] = slides != 0 ? plastic_strain[i] + multiplier / std::sqrt(3.0) : plastic_strain[i];
+    plastic[k] = slides != 0 ? volume[i] * r.work : 0.0;
+    plastic_strain[i] = slides != 0 ? plastic_strain[i] + r.multiplier / std::sqrt(3.0) : plastic_strain[i];
     double* const a = acting + 4 * i;
-    a[0] = slides != 0 ? r00 : s0;
-    a[1] = slides != 0 ? r10 : s1;
-    a[2] = slides != 0 ? r01 : s2;
-    a[3] = slides != 0 ? r11 : s3;
-    acting_zz[i] = slides != 0 ? r_zz : s_zz;
+    a[0] = slides != 0 ? r.r00 : s0;
+    a[1] = slides != 0 ? r.r10 : s1;
+    a[2] = slides != 0 ? r.r01 : s2;
+    a[3] = slides != 0 ? r.r11 : s3;
+    acting_zz[i] = slides != 0 ? r.r_zz : s_zz;
     e[0] = slides != 0 ? e0 : x0;
     e[1] = slides != 0 ? e1 : x1;
     e[2] = slides != 0 ? e2 : x2;
     e[3] = slides != 0 ? e3 : x3;
-    const double back_zz = crack(r_zz, open);
+    const double back_zz = crack(r.r_zz, open);
     effective_zz[i] = slides != 0 ? back_zz : zz;
   }
   Dissipation total;
@@ -579,111 +506,5 @@ double ElasticDamage<Dim>::strain_energy(const Particles<Dim>& p, const std::vec
 
 template class ElasticDamage<2>;
 template class ElasticDamage<3>;
-
-namespace {
-
-using scene::Range;
-
-template <int Dim>
-std::unique_ptr<Material<Dim>> read(const scene::Table& m, const MaterialContext& c) {
-  DamageParameters d{};
-  d.cohesion = m.quantity({"cohesion", "Mohr-Coulomb cohesion c of the intact coal", "", Range::positive()},
-                          units::pressure);
-  d.friction_angle = m.quantity({"friction_angle", "Mohr-Coulomb friction angle (also of the fragments)", "",
-                                 Range{0.0, 1.5, true, false}},
-                                units::angle);
-  d.tensile_strength = m.quantity({"tensile_strength", "tensile strength f_t", "", Range::positive()},
-                                  units::pressure);
-  d.residual_ratio = m.number({"residual_ratio", "residual strength / strength, in compression, and in tension "
-                                                 "under the local law (the paper gives none; 0.1 is common "
-                                                 "for RFPA models)",
-                               "0.1", Range{0.0, 1.0, true, false}});
-  // The two regularised laws exclude each other: said before either checks
-  // its resolution.
-  if (m.has("fracture_energy") && m.has("internal_length"))
-    m.fail("internal_length", "give a fracture_energy (a crack band) or an internal_length (nonlocal damage), "
-                              "not both");
-  if (m.has("fracture_energy")) {
-    // Crack band: the ultimate strain follows from G_f and the width of the
-    // narrowest band the grid's velocity field can open.
-    if (m.has("ultimate_strain_ratio"))
-      m.fail("ultimate_strain_ratio", "give the ultimate strain ratio (the paper's local law) or a "
-                                      "fracture_energy (a crack band), not both");
-    d.fracture_energy = m.quantity({"fracture_energy", "G_f, energy per unit crack area dissipated in tension "
-                                                       "(K_Ic^2 / E): a crack band as wide as a crack opens on "
-                                                       "the grid (a cell; two under B-splines) softens linearly "
-                                                       "so that it dissipates G_f whatever the cell size",
-                                    "", Range::positive()},
-                                   units::energy_per_area);
-    d.band_width = c.crack_cells * c.cell_size;
-    if (const double widest = largest_band_width(d, c.elasticity); d.band_width > widest)
-      m.refuse("fracture_energy",
-               fmt::format("cells of {:g} m are too coarse for a crack band with G_f = {:g} J/m2: a band {} wide "
-                           "(as wide as a crack opens under these shape functions) would dissipate more at its "
-                           "peak, f_t^2 / (2 E) per unit volume, than G_f allows; refine mpm.grid.cell_size to at "
-                           "most 2 E G_f / f_t^2 / {} = {:.4g} m, or raise G_f",
-                           c.cell_size, *d.fracture_energy,
-                           c.crack_cells == 1 ? std::string("one cell") : fmt::format("{} cells", c.crack_cells),
-                           c.crack_cells, widest / c.crack_cells));
-  } else {
-    d.ultimate_ratio = m.number({"ultimate_strain_ratio", "eta = ultimate tensile strain / strain at f_t, beyond "
-                                                          "which D = 1 (the paper gives none; 5-10 is common); "
-                                                          "or give a fracture_energy",
-                                 "5", Range::at_least(1)});
-  }
-  if (m.has("internal_length")) {
-    d.internal_length = m.quantity({"internal_length", "R, radius over which nonlocal damage averages its driving "
-                                                       "strain (a bell-shaped weight): the crack spreads over a zone "
-                                                       "a few R wide, softening linearly to nothing at eta",
-                                    "", Range::positive()},
-                                   units::length);
-    if (d.ultimate_ratio <= 1)
-      m.fail("ultimate_strain_ratio", fmt::format("must be > 1 with an internal_length (nonlocal damage softens from "
-                                                  "1 to eta), got {:g}",
-                                                  d.ultimate_ratio));
-    // Fewer than two cells across R: too few particles to average over, and
-    // the zone would follow the cell again.
-    if (*d.internal_length < 2 * c.cell_size)
-      m.refuse("internal_length",
-               fmt::format("an internal length of {:g} m is not resolved by cells of {:g} m: refine "
-                           "mpm.grid.cell_size to at most R / 2 = {:.4g} m, or lengthen R",
-                           *d.internal_length, c.cell_size, *d.internal_length / 2));
-  }
-  d.bulking_factor = m.number({"bulking_factor", "largest volume of fully damaged coal over its volume at t = 0: "
-                                                 "broken coal bulks to a loose heap, its fragments then part "
-                                                 "(1.3-1.6 is typical of broken coal)",
-                               "1.5", Range::at_least(1)});
-  if (const auto h = m.table("heterogeneity", "heterogeneous coal: each particle's strengths and moduli scaled by "
-                                               "Weibull draws of mean 1 (RFPA's approach)", false)) {
-    const double index = h->number({"homogeneity_index", "Weibull shape m of the strengths: the larger, the more "
-                                                         "uniform the coal (1.5-5 is typical of RFPA models of coal "
-                                                         "and rock)",
-                                    "", Range::at_least(1)});
-    const std::string same_as_strength = fmt::format("{:.17g}", index);
-    d.heterogeneity = DamageParameters::Heterogeneity{
-        index,
-        static_cast<std::uint64_t>(h->integer<std::int64_t>(
-            {"seed", "seed of the draw: the same seed, the same coal", "1", Range::non_negative()})),
-        h->number({"modulus_homogeneity_index", "Weibull shape m_E of the elastic moduli, drawn apart from the "
-                                                "strengths (default: the homogeneity_index); the stiffest particle "
-                                                "sets the stable step",
-                   same_as_strength, Range::at_least(1)}),
-        h->has("grain_size")
-            ? std::optional(h->quantity({"grain_size", "side of the squares (cubes in 3D) of coal that share one draw (a grid "
-                                                       "through the origin): the random field's correlation "
-                                                       "length, so that refining the particles keeps the same "
-                                                       "coal; without it each particle draws its own, and a finer "
-                                                       "grid makes a finer-grained coal",
-                                         "", Range::positive()},
-                                        units::length))
-            : std::nullopt};
-  }
-  return std::make_unique<ElasticDamage<Dim>>(c.name, c.elasticity, d);
-}
-
-[[maybe_unused]] const bool registered =
-    register_material({"elastic_damage", "brittle, leaving granular fragments", read<2>, read<3>});
-
-}  // namespace
 
 }  // namespace outburst::mpm
