@@ -20,8 +20,8 @@ def host():
     """The processor a comparison ran on: its model (with family and model
     numbers, since a virtual machine may report no more than a brand name),
     its widest vector extension and the logical CPUs this process may use. A
-    build's ratio to another depends on it (README.md, "The same builds on
-    another processor"): kernels vectorised over particles gain more from
+    build's ratio to another depends on it (docs/performance/index.md,
+    "Hosts"): kernels vectorised over particles gain more from
     256-bit vectors than from 128-bit ones."""
     fields = {}
     try:

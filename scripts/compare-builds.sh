@@ -13,8 +13,8 @@
 #   which commit of a range moved a result).
 #   SCENE: a scene file, read from this checkout by both builds (default:
 #   every plane scene shipped, the outburst to its end, 1 s). Work folder:
-#   $COMPARE_DIR (default /tmp/outburst-compare); builds are kept there and
-#   rebuilt incrementally.
+#   $COMPARE_DIR (default $TMPDIR/outburst-compare, TMPDIR by default /tmp);
+#   builds are kept there and rebuilt incrementally.
 # Exit 0 when every scene's results are equal, 1 when one differs.
 set -euo pipefail
 # Scene paths as given, from the caller's folder.
@@ -43,7 +43,7 @@ scenes=("$@")
   cases/elastic_block/elastic_block.toml cases/granular_collapse/granular_collapse.toml
   cases/gas_face/gas_face.toml cases/terzaghi/terzaghi.toml cases/mandel/mandel.toml
   cases/outburst/outburst.toml)
-work=${COMPARE_DIR:-/tmp/outburst-compare}
+work=${COMPARE_DIR:-${TMPDIR:-/tmp}/outburst-compare}
 mkdir -p "$work"
 checkout() {  # checkout FOLDER COMMIT: a worktree of this repository at COMMIT
   if [ ! -d "$1" ]; then

@@ -25,11 +25,10 @@ reference each round's figures then come from one program shape (a whole
 run lasts about twenty seconds, a row-wise one a second or two), run back
 to back, for the medians to pair.
 The printout's first line and the CSV's last column name the processor:
-the ratios depend on it (README.md, "The same builds on another
-processor").
+the ratios depend on it (docs/performance/index.md, "Hosts").
 
 usage: compare-mpm-benchmark.py [--particles N] [--rounds R] [--dimension 2|3] [--cpu C] [--shape S] [--material M] [--whole] [--csv FILE] NAME=BUILD_DIR ...
-  e.g. compare-mpm-benchmark.py before=/tmp/old/build after=build
+  e.g. compare-mpm-benchmark.py before=../old/build after=build
 """
 import argparse
 import csv

@@ -8,13 +8,13 @@ particle count, shape and material (B-splines, elastic_damage) and threads,
 and the parts of the wall time by the program's own clocks (wall_times.csv).
 
 usage: scripts/outburst-benchmark.py [--threads 2] [--only first_second|to_rest] [--set KEY=VALUE ...] [--csv FILE] [--out DIR] NAME=BUILD_DIR ...
-  e.g. scripts/outburst-benchmark.py --csv results/outburst-benchmark.csv before=/tmp/old/build after=build
+  e.g. scripts/outburst-benchmark.py --csv results/outburst-benchmark.csv before=../old/build after=build
 --set adds a scene override (as the outburst program's --set) to every run, after the case's own: a
 longer step, say, costed against the shipped one's rows of another run.
 Run it on an idle machine: two threads that share their cores with other
 work wait on each other at every barrier. The processor is printed first
 and written as the CSV's last column, host: the wall times depend on it
-(README.md, "The same builds on another processor").
+(docs/performance/index.md, "Hosts").
 """
 import argparse
 import csv

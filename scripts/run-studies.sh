@@ -2,7 +2,7 @@
 # Regenerates the shipped studies: every cases/<case>/study.toml (accuracy
 # against time) and schemes.toml (coupling schemes and windows), each run with
 # cases.study into results/<case>_<spec>/, its table, plot and CSVs copied
-# to cases/<case>/<spec>/, which the READMEs link. About 6 minutes on 2 cores.
+# to cases/<case>/<spec>/, which the manual shows (docs/verification/). About 6 minutes on 2 cores.
 # Needs a build (scripts/run-main.sh makes one).
 set -eu
 cd "$(dirname "$0")/.."

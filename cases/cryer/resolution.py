@@ -7,7 +7,7 @@ runs cryer.toml with the seepage's and the MPM's cells both a / 8, a / 12 and
 a / 16 (one thread each, `jobs` side by side) and writes OUT/resolution.csv:
 a row per run with the errors of measure.py (over the outputs, every 0.02 s)
 and its wall time. The shipped copy is resolution/resolution.csv beside this
-file; cases.readme_tables writes README.md's table from it. --measure-only
+file; cases.readme_tables writes docs/verification/cryer.md's table from it. --measure-only
 runs nothing and measures the runs OUT holds (their rows without wall_s).
 """
 import argparse

@@ -13,8 +13,8 @@ cells) and OUT/convergence.png; one run at a time, each on every core (the
 finest, 1/8 m, takes 20-25 minutes to 1 s on 2 cores; the whole study about an
 hour and a half). Each finished run is kept in its folder (run.json): --resume
 measures those instead of running them again, --measure-only runs nothing.
-With --seeds N the coal is heterogeneous (mpm_solid/README.md, Heterogeneous
-coal): N seeds at each cell, J side by side, and OUT/convergence_ensemble.csv
+With --seeds N the coal is heterogeneous (docs/theory/materials.md,
+heterogeneous coal): N seeds at each cell, J side by side, and OUT/convergence_ensemble.csv
 and .md give each quantity's mean and 95 % interval by cell, and whether the
 two finest cells' means differ (Welch's t-test at 5 %).
 """

@@ -7,8 +7,8 @@ usage: python3 -m cases.outburst.ensemble [--outburst build/coupler/outburst] [-
                                           [--set KEY=VALUE ...] [--sweep KEY --values V1 V2 ...] [--resume]
 
 Each run is the shipped case with mpm.materials[0].heterogeneity = {
-homogeneity_index = M, seed = k} for k = 1..N (mpm_solid/README.md,
-Heterogeneous coal), plus the --set overrides. J runs go side by side with
+homogeneity_index = M, seed = k} for k = 1..N (docs/theory/materials.md,
+heterogeneous coal), plus the --set overrides. J runs go side by side with
 cores / J threads each, so jobs x threads never exceed the cores. Writes
 OUT/ensemble.csv (a row per seed), OUT/ensemble.md (the statistics) and
 OUT/ensemble.png (each quantity's runs, mean and interval). With --sweep, one

@@ -431,7 +431,7 @@ ENERGY_NOTE = ("The grid transfer is what the grid-to-particle transfer takes fr
                "of the FLIP/PIC blend (or APIC) takes the velocity differences of coal within a cell, separating "
                "fragments above all, and the update's spread over each particle's nodes is lost in its "
                "interpolation. The time step is the explicit step's own energy error (negative: energy it gave); "
-               "both fall with the step. The balance error is what neither holds (mpm_solid/README.md, Energies).")
+               "both fall with the step. The balance error is what neither holds (docs/theory/energies.md).")
 
 
 def write_report(run, args, gradients, path):
@@ -464,7 +464,7 @@ def write_report(run, args, gradients, path):
     lines = [
         "# Outburst case: measured figures beside the paper's",
         "",
-        f"Run: `{os.path.abspath(run.dir)}`, {run.times[-1]:.3g} s simulated, "
+        f"Run: `{os.path.basename(os.path.normpath(run.dir))}`, {run.times[-1]:.3g} s simulated, "
         f"{len(x0)} particles, {len(run.cells)} seepage cells; kinetic energy at the end "
         f"{rest_ratio:.1%} of its peak.",
         "",

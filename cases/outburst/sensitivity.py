@@ -39,7 +39,7 @@ VARIANTS = [
     ("grid 0.25 m", ['mpm.grid.cell_size="0.25 m"']),
     ("3 x 3 particles per cell", ["mpm.bodies[0].particles_per_cell=3"]),
     # Particles 1/9 m apart fill 0.25 m seepage cells to 79 % at least (2 x 2,
-    # 1/6 m apart, would leave some at 44 %: refused, coupler/README.md).
+    # 1/6 m apart, would leave some at 44 %: refused: docs/user-guide/bad-input.md).
     ("seepage mesh 0.25 m, 3 x 3 particles per cell", ["mpm.bodies[0].particles_per_cell=3", "FINE_MESH"]),
 ]
 # The grid transfer (the PIC share of the FLIP/PIC blend, or APIC) at the
@@ -61,7 +61,7 @@ VARIANTS += [
     ("crack band 2.4 J/m2, heterogeneous m = 3, seed 1",
      ["CRACK_BAND=2.4 J/m2", "mpm.materials[0].heterogeneity={homogeneity_index=3, seed=1}"]),
     # Nonlocal damage over the shortest length the shipped cells resolve (two
-    # cells: mpm_solid/README.md), with the shipped eta.
+    # cells: docs/theory/fracture.md), with the shipped eta.
     ("nonlocal damage, R = 0.75 m", ['mpm.materials[0].internal_length="0.75 m"']),
 ]
 FINE_SEEPAGE_H = 0.25

@@ -156,8 +156,8 @@ def figures(run, out):
 
 
 # The comparison's rows: a label, then how a 3D row and a plane row of
-# numbers read in it, and the paper's. Shared by report.md and the case
-# README's generated table (cases.readme_tables).
+# numbers read in it, and the paper's. Shared by report.md and the
+# manual's generated tables (cases.readme_tables: docs/cases/outburst-3d.md, docs/cases/outburst.md).
 def _triple(h, key, unit):
     return " / ".join(f"{h[f'{k}_{key}']:.3g}" for k in ("centre", "top", "bottom")) + f" {unit}"
 
@@ -265,10 +265,10 @@ def write_report(run, h, plane, plane_dir, gradients, path):
     lines = [
         "# 3D outburst at a heading: measured figures beside the plane case's and the paper's",
         "",
-        f"Run: `{os.path.abspath(run.dir)}` ({h['version']}), {h['simulated_s']:.3g} s simulated, "
+        f"Run: `{os.path.basename(os.path.normpath(run.dir))}` ({h['version']}), {h['simulated_s']:.3g} s simulated, "
         f"{h['particles']:.0f} particles, {h['seepage_cells']:.0f} seepage hexahedra; kinetic energy at the end "
         f"{h['kinetic_end_share']:.1%} of its peak. {start}"
-        + (f" The plane case: `{os.path.abspath(plane_dir)}` ({plane['version']})." if plane else ""),
+        + (f" The plane case: `{os.path.basename(os.path.normpath(plane_dir))}` ({plane['version']})." if plane else ""),
         "",
         f"The model is half of a heading {2 * h['heading_half_width_m']:g} m wide (z = 0 its plane of symmetry) in a "
         f"seam reaching z = {h['seam_far_side_m']:g} m (headings {2 * h['seam_far_side_m']:g} m apart). Its volumes "

@@ -1,7 +1,6 @@
 #!/usr/bin/env bash
 # The 3D outburst (outburst_3d.toml) from one command: the run, then its
-# report and figures beside the plane case's numbers (README.md beside this
-# file). Usage:
+# report and figures beside the plane case's numbers (docs/cases/outburst-3d.md). Usage:
 #   cases/outburst_3d/run.sh [--fine] [RESULTS_DIR]
 # default RESULTS_DIR results/outburst_3d (results/outburst_3d_fine with
 # --fine: the plane case's cells of 1/3 m, 233,280 particles). On all cores;
