@@ -2,7 +2,7 @@
 // The processor a benchmark ran on. A kernel vectorised over particles gains
 // more from wide vectors than from narrow ones, so a throughput, or a ratio
 // of two builds' throughputs, is a figure of the processor as much as of the
-// code (README.md, "The same builds on another processor").
+// code (docs/performance/index.md#hosts).
 
 #include <string>
 

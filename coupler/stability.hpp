@@ -1,6 +1,7 @@
 #pragma once
 // Stability of the poroelastic window schemes (Biot storage coupling): the
-// amplification of one window per wavenumber; coupler/README.md derives it.
+// amplification of one window per wavenumber; docs/theory/coupling.md#7-stability-of-the-window-schemes
+// derives it.
 //
 // The model is one Fourier mode of a uniaxial column, wavenumber kappa:
 //   solid:  rho (eps'' + c eps') = -kappa^2 (M_c eps - alpha p)

@@ -162,7 +162,7 @@ template <int Dim>
 // store it); else a chunk's, one SIMD lane per member, entry e = r + Dim c
 // (Eigen's order) of member k at gradients[e * chunk_size + k]. The fused
 // pass keeps them so, out of the particles' arrays, whose stores were a
-// measurable share of its step (README.md, The MPM solver).
+// measurable share of its step (docs/performance/log.md#the-mpm-kernel).
 inline constexpr int chunk_size = 64;
 
 // A split pass's stress update reads p.velocity_gradient, which only runs

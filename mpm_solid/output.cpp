@@ -172,7 +172,7 @@ void Output<Dim>::finish() const {
   if (open > 0.01)
     spdlog::warn("the energy budget is open by {:.2g} % of its largest term ({:.3g} {}) at t = {:.4g} s: a "
                  "velocity changed where no book sees it, which is a defect of the solver; please report it with "
-                 "the scene (mpm_solid/README.md, Energies; mpm_history.csv)",
+                 "the scene (docs/theory/energies.md; mpm_history.csv)",
                  100 * open, audit_.largest_term(), unit, audit_.worst_time());
   else
     spdlog::info("energy budget closed to {:.2g} % of its largest term ({:.3g} {}); the time step's own error at "

@@ -27,7 +27,7 @@ namespace outburst::mpm {
 // left and stops the run at a non-finite position; the move's mapping ahead
 // skips the chunks the census found such a particle in). Holding x there first
 // cost every kernel 15 %
-// (mpm_solid/benchmark/compare-63e0ffd-de26bb6-290380f-e0a5804.csv): GCC 12
+// (docs/performance/log.md#the-mpm-kernel): GCC 12
 // sinks the conversion into the select's branches, where it may trap, and keeps
 // the stencils' loops scalar again. Near int's ends one lower wraps: unsigned,
 // so that the wrap is defined, and the support check refuses it (supported()).

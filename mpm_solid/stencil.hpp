@@ -87,7 +87,8 @@ struct Stencil {
 
 // Particles per chunk of the passes over SIMD lanes: several vectors' worth,
 // and few enough that a chunk's stencils and sums stay in L1 (32 measured a
-// little faster than 16 in every row of mpm-benchmark, 8 slower: README.md).
+// little faster than 16 in every row of mpm-benchmark, 8 slower:
+// docs/performance/mpm.md#chunks-of-32-particles).
 inline constexpr int chunk_lanes = 32;
 
 // The stencils of a chunk of up to Width particles, one lane per particle:
@@ -96,8 +97,8 @@ inline constexpr int chunk_lanes = 32;
 // (under unit slopes a factor of -1 or 1 taken as a sign). Nothing per node
 // is stored and read back, and the gathers' node loops run over the lanes,
 // for the compiler to vectorise, or over a lane's nodes a pair of components
-// at a time (mpm_solid/gathers.hpp; README.md, The MPM solver, has what each
-// gained).
+// at a time (mpm_solid/gathers.hpp; docs/performance/mpm.md#the-gathers-lanes-or-pairs
+// has what each gained).
 template <int Dim, class Shape, int Width = chunk_lanes>
 struct StencilLanes {
   static constexpr int support = Shape::support;
@@ -114,8 +115,8 @@ struct StencilLanes {
   static constexpr bool unit_slopes = requires { requires Shape::unit_slopes; };
   // d w / d x [1/m]: 1 / h taken once per lane and direction, where it used
   // to be taken at every node's gradient (a product fewer per node and
-  // direction in the velocity gradient and force passes: README.md, The MPM
-  // solver). Under unit slopes w times 1 / h instead (a product, as the
+  // direction in the velocity gradient and force passes:
+  // docs/performance/log.md#the-mpm-kernel). Under unit slopes w times 1 / h instead (a product, as the
   // gradients' is: a division would round otherwise): a gradient's factor
   // along its own direction is then -1 / h or 1 / h, and in the plane a
   // gradient is one of these entries, signed.
@@ -205,7 +206,7 @@ struct StencilLanes {
   // particles seeded in it. A quadratic B-spline stencil starts at the
   // nearest node's lower neighbour, so a cell's particles at 2 a side have
   // four different ones, and runs done for every shape had slowed B-splines
-  // (README.md, The MPM solver). GIMP's seeds do share a stencil, but with
+  // (docs/performance/mpm.md#scatters-in-runs-under-linear-shapes). GIMP's seeds do share a stencil, but with
   // runs its scatters measured slower in single runs (not kept).
   static constexpr bool runs = support == 2;
 

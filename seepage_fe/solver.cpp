@@ -33,7 +33,7 @@ class ScopedTimer {
 // The fastest numeric factorisation by size and dimension, read from
 // seepage_fe/benchmark/orderings.csv and orderings_3d.csv
 // (`seepage-benchmark --orderings-csv`, on the unit square, the outburst's
-// meshes and the unit cube; the README tables them). In 2D below about 5000
+// meshes and the unit cube; docs/performance/seepage.md tables them). In 2D below about 5000
 // unknowns simplicial: its loops beat supernodal's BLAS calls, and the
 // orderings tie, so AMD, the quickest to compute. From there, and in 3D at
 // every size (a hexahedron couples 27 nodes, and the fronts are wide from the

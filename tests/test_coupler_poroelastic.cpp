@@ -176,7 +176,7 @@ CryerRun run_cryer(int n, const Cryer& exact) {
 
 // The sphere drains where its coal leaves seepage cells open: its surface is
 // a staircase of cells, to within a cell of the sphere, so the error falls at
-// first order with the cells (cases/cryer/README.md tables a / 16 too).
+// first order with the cells (docs/verification/cryer.md#convergence tables a / 16 too).
 TEST_CASE("Cryer's sphere: the centre's pressure rises above its undrained value and decays as the analytic "
           "series says, closer as the cells shrink",
           "[coupler][poroelastic][cryer][3d]") {

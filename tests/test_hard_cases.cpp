@@ -174,7 +174,7 @@ TEST_CASE("hard: Terzaghi with a nearly incompressible fluid (S M = 0.01 and 0.0
   for (double sm : {0.01, 0.001}) {
     for (const auto& [label, acceleration] : accelerations) {
       // Constant relaxation takes about 65 sub-iterations a window here
-      // (coupler/README.md): 0.1 s of it shows its stability.
+      // (docs/verification/coupling-stability.md): 0.1 s of it shows its stability.
       const double end = acceleration == "constant" ? 0.1 : 0.5;
       const Outcome o = terzaghi(sm / m, {fmt::format("coupling.acceleration=\"{}\"", acceleration),
                                           "coupling.max_iterations=300"},

@@ -128,8 +128,8 @@ int main(int argc, char** argv) {
   app.add_option("particles", sizes, "particles of each row's block (at least 100; 1e5 is read)")
       ->check(CLI::Range(100.0, 1e9))
       ->capture_default_str();
-  app.add_option("--csv", csv_path, "also write the rows to this CSV file (README.md's table is written from "
-                                    "mpm_solid/benchmark/mpm-benchmark.csv)");
+  app.add_option("--csv", csv_path, "also write the rows to this CSV file (docs/performance/mpm.md's table is written "
+                                    "from mpm_solid/benchmark/mpm-benchmark.csv)");
   const std::map<std::string, ShapeKind> shape_words{
       {"linear", ShapeKind::linear}, {"gimp", ShapeKind::gimp}, {"bspline", ShapeKind::bspline}};
   const std::map<std::string, Model> model_words{
@@ -164,7 +164,7 @@ int main(int argc, char** argv) {
   for (const auto& name : model_names) models.push_back(model_words.at(name));
   std::FILE* csv = nullptr;
   if (!csv_path.empty()) {
-    // The CSV's columns are one and two threads (README.md's table).
+    // The CSV's columns are one and two threads (docs/performance/mpm.md#throughput).
     if (thread_counts != std::vector<int>{1, std::min(2, cores)}) {
       std::fprintf(stderr, "mpm-benchmark: --csv writes the columns of 1 and 2 threads; leave --threads out\n");
       return 2;
@@ -201,7 +201,7 @@ int main(int argc, char** argv) {
         std::printf(" %9.2f %14.0f %14.0f\n", speed_up, static_cast<double>(last.memory.particles) / count,
                     static_cast<double>(last.memory.grid) / count);
         std::fflush(stdout);
-        // The CSV keeps its two columns (one and two threads) for the README's table.
+        // The CSV keeps its two columns (one and two threads) for the manual's table.
         if (csv)
           std::fprintf(csv, "%ld,%s,%s,%.4e,%.4e,%.3f,%.0f,%.0f,%s\n", n, shape_name(shape), model_name(model),
                        rows.front().particle_steps_per_second, last.particle_steps_per_second, speed_up,

@@ -379,8 +379,8 @@ struct PlaneReturn {
 // is summed in the members' order. The cap is kept out of the lanes: its
 // load of the initial volume, made only where the damage is full, would
 // need a masked load in them, which GCC 12 refused for the 128-bit vectors
-// of its Zen 1 tuning, and the whole loop stayed scalar there (README.md,
-// "The same builds on another processor").
+// of its Zen 1 tuning, and the whole loop stayed scalar there
+// (docs/performance/mpm.md#compiler-flags).
 template <int Dim>
 template <bool Drawn, bool Band, class Index>
 Dissipation ElasticDamage<Dim>::settle_plane(Particles<Dim>& p, std::span<const int> members, Index index) const {

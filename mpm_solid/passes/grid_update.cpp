@@ -102,10 +102,10 @@ void Solver<Dim>::grid_update(double dt) {
   // masses are the particles' mapped with the same weights, a ghost's folded
   // into its mirror, whose |dv| it shares (as the first sum takes its p_i;
   // apply_walls leaves every ghost its mirror's motion, where a friction wall
-  // meets a fixed one too). Taken particle by
-  // particle, over each stencil's nodes, it cost the step 4-5 % (README.md,
-  // "The transfer's spread over the nodes"); it is also all the transfer
-  // keeps, less sum_p m_p |dv_p|^2 / 2 (gather_motion).
+  // meets a fixed one too). Taken particle by particle, over each
+  // stencil's nodes, it cost the step 4-5 % (docs/performance/log.md); it is
+  // also all the transfer keeps, less sum_p m_p |dv_p|^2 / 2 (gather_motion;
+  // docs/theory/energies.md#3-the-transfer-book).
   double work = 0, projected = 0, spread = 0;
   const int nr = static_cast<int>(runs.size());
 #pragma omp parallel for schedule(static) reduction(+ : work, projected, spread)

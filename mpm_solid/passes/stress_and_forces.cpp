@@ -188,11 +188,11 @@ long Solver<Dim>::scatter_forces() {
 // chunk of each material's particles at a time: the chunk's stencils and
 // fields are still in cache when its forces are scattered, where three
 // passes would compute the stencils twice and stream the fields three times.
-// It measured faster under quadratic B-splines from the start
-// (mpm_solid/benchmark/compare-c88bc1c-fused.csv) and under linear shapes,
-// whose stencils cost little to compute again, once the materials' trial ran
-// over lanes (compare-fused-linear-b53d828.csv; before, no faster:
-// compare-lanes-fused-linear.csv). The chunk's velocity gradients stay in
+// It measures faster under quadratic B-splines and, since the materials'
+// trial runs over lanes, under linear shapes too, whose stencils cost little
+// to compute again (mpm_solid/benchmark/fused-pass-bspline.csv and
+// fused-pass-linear.csv; docs/performance/mpm.md#the-fused-update-stress-first-pass).
+// The chunk's velocity gradients stay in
 // its lanes (see chunk_size), so the pore pressure's work, which reads them,
 // is booked here rather than in the census.
 template <int Dim>
@@ -232,7 +232,7 @@ long Solver<Dim>::update_and_scatter(double dt) {
           damage += d.damage;
           // The census's check of the stresses, here where they are still in
           // L1: the motion pass reads 32 B a particle less in the plane, 72 B
-          // in 3D (README.md, "The census's stress check in the update").
+          // in 3D (docs/performance/log.md#the-mpm-kernel).
           broken += non_finite_stresses(p, particle, lanes);
           // A pore pressure does work on the skeleton as it dilates (at
           // the volume the update left, as the census books it).
