@@ -78,7 +78,7 @@ def toml_value(v):
     if isinstance(v, bool):
         return "true" if v else "false"
     if isinstance(v, (int, float)):
-        return repr(v) if isinstance(v, int) else {"inf": "inf", "-inf": "-inf", "nan": "nan"}.get(repr(v), repr(v))
+        return repr(v)  # TOML writes 1e-10, inf and nan as Python does
     if isinstance(v, str):
         return json.dumps(v, ensure_ascii=False)
     if isinstance(v, list):
@@ -115,7 +115,8 @@ def without(scene, key):
 def without_it(build, program, scene, key):
     """What the program makes of the scene without the key: "required" (it
     stops, asking for the key), "optional" (it reads the scene) or "other" (it
-    stops over another key, which the scene set up for this one)."""
+    stops over another key, which the scene set up for this one). The
+    message is common/scene.cpp's for a required key."""
     done = run_explain(build, program, scene, [without(scene, key)])
     if done.returncode == 0:
         return "optional"
