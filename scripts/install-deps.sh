@@ -19,6 +19,12 @@ packages=(
   # the ensembles' confidence intervals (Student t); the scenes' units read
   # in Python (cases/units.py); the Python tests (tests/python)
   python3-scipy python3-pint python3-pytest
+  # the manual (docs/, mkdocs.yml): MkDocs and its Material theme, which brings
+  # the pymdownx extensions mkdocs.yml names; CTest builds it with --strict
+  mkdocs mkdocs-material
+  # the main job's film (cases/outburst/animate.py): matplotlib writes H.264
+  # through ffmpeg, and a GIF through Pillow where no encoder is installed
+  ffmpeg python3-pil
 )
 
 missing=()

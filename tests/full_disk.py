@@ -7,7 +7,7 @@ The disk "fills" through RLIMIT_FSIZE (no file may grow past 30 kB, and
 SIGXFSZ is ignored so the write fails with EFBIG): the seepage snapshots
 (16 kB) fit, the first particle snapshot (100 kB) does not.
 
-usage: full_disk.py OUTBURST SCENE WORK_DIR"""
+usage (from the top folder): python3 -m tests.full_disk OUTBURST SCENE WORK_DIR"""
 import os
 import resource
 import shutil
@@ -15,8 +15,7 @@ import signal
 import subprocess
 import sys
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from run_folder import leftovers, listed, unreadable  # noqa: E402
+from tests.run_folder import leftovers, listed, unreadable
 
 
 def fill_at_30_kb():

@@ -10,7 +10,7 @@ one ulp must differ: the comparison sees that much. Then the refusals (exit code
 2): no folder, a folder without a checkpoint, another scene text, mesh, set of
 overrides, version or build, and a fresh run into a folder that holds one.
 
-usage: restart.py BUILD_DIR SOURCE_DIR WORK_DIR [SEED]"""
+usage (from the top folder): python3 -m tests.restart BUILD_DIR SOURCE_DIR WORK_DIR [SEED]"""
 import os
 import random
 import re
@@ -25,8 +25,7 @@ from collections import namedtuple
 import h5py
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from run_folder import compare_checkpoints, compare_histories, compare_listed, leftovers, listed  # noqa: E402
+from tests.run_folder import compare_checkpoints, compare_histories, compare_listed, leftovers, listed
 
 
 # stops: (signal, stage) pairs; the stage is "settling" or "run".

@@ -4,7 +4,7 @@ exit code 3, a log line saying so, the state it reached as the last snapshot
 listed in its index (readable), and histories complete up to it. Before,
 the signal killed the run like kill -9, losing up to an output interval.
 
-usage: stop_signal.py BUILD_DIR SOURCE_DIR WORK_DIR"""
+usage (from the top folder): python3 -m tests.stop_signal BUILD_DIR SOURCE_DIR WORK_DIR"""
 import csv
 import os
 import re
@@ -14,8 +14,7 @@ import subprocess
 import sys
 import time
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from run_folder import leftovers, listed, unreadable  # noqa: E402
+from tests.run_folder import leftovers, listed, unreadable
 
 # program, scene, overrides for a run far longer than the test, signal, the
 # indexes and the histories whose last time must be the stop's.

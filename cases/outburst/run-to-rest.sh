@@ -14,3 +14,4 @@ build/coupler/outburst cases/outburst/outburst.toml --output "$out" \
   --set 'mpm.grid.origin=["-75 m", "0 m"]' --set 'mpm.grid.size=["120 m", "9 m"]' \
   --set 'mpm.obstacles[0].box_min=["-75 m", "0 m"]' --set 'mpm.obstacles[1].box_min=["-75 m", "6 m"]'
 /usr/bin/python3 -m cases.outburst.report "$out"
+/usr/bin/python3 -m cases.outburst.animate "$out"
