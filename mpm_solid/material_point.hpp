@@ -2,11 +2,12 @@
 // A constitutive law written for one material point, as CB-Geo's interface
 // has it (the stress from the strain increment and the point's state), run
 // by a generic adapter inside the solver's chunk of lanes. The law knows
-// nothing of lanes or chunks; the adapter takes each member of the chunk in
-// turn, does the kinematics every law shares (F, the volume) and the
-// objective part of the Jaumann rate (the stress turned with the material's
-// spin), and hands the law what is left: the stress increment from the
-// strain increment, and any return to a yield surface.
+// nothing of lanes or chunks: the adapter does, over the chunk's SIMD lanes
+// as the lane-wise laws do, the kinematics every law shares (F, the volume)
+// and the objective part of the Jaumann rate (the stress turned with the
+// material's spin), then takes each member in turn and hands the law what is
+// left: the stress increment from the strain increment, and any return to a
+// yield surface.
 //
 // A law is a class with
 //   Dissipation update(MaterialPoint<Dim>& point, Particles<Dim>& p) const;
@@ -61,6 +62,10 @@ class PointMaterial final : public Material<Dim> {
   // particle's own.
   Dissipation update_chunk(Particles<Dim>& p, std::span<const int> members, double dt,
                            const double* gradients) const override {
+    // The kinematics and the spin's turn over SIMD lanes, as the lane-wise
+    // laws take them: deform_and_trial with no moduli adds dt (W s - s W)
+    // alone.
+    deform_and_trial(p, members, dt, 0.0, 0.0, nullptr, p.stress, p.stress_zz, gradients);
     Dissipation total;
     for (std::size_t k = 0; k < members.size(); ++k) {
       const int i = members[k];
@@ -69,25 +74,17 @@ class PointMaterial final : public Material<Dim> {
         for (int e = 0; e < Dim * Dim; ++e) l.data()[e] = gradients[e * chunk_size + static_cast<int>(k)];
       else
         l = p.velocity_gradient[i];
-      total += update_point(p, i, l, dt);
+      total += update_point(p, i, Mat<Dim>(0.5 * dt * (l + l.transpose())));
     }
     return total;
   }
 
  private:
-  Dissipation update_point(Particles<Dim>& p, int i, const Mat<Dim>& l, double dt) const {
-    p.deformation[i] = (Mat<Dim>::Identity() + dt * l) * p.deformation[i];
-    p.volume[i] = p.volume0[i] * p.deformation[i].determinant();
-    const Mat<Dim> d = 0.5 * (l + l.transpose()), w = 0.5 * (l - l.transpose());
-    const Mat<Dim>& s = p.stress[i];
+  Dissipation update_point(Particles<Dim>& p, int i, const Mat<Dim>& strain_increment) const {
     double none = 0;
     double& zz = out_of_plane<Dim>(p.stress_zz, i, none);
-    MaterialPoint<Dim> point{Mat<Dim>(s + dt * (w * s - s * w)),
-                             zz,
-                             Mat<Dim>(dt * d),
-                             p.volume[i],
-                             p.modulus_scale.empty() ? 1.0 : p.modulus_scale[i],
-                             i};
+    MaterialPoint<Dim> point{p.stress[i], zz, strain_increment, p.volume[i],
+                             p.modulus_scale.empty() ? 1.0 : p.modulus_scale[i], i};
     const Dissipation dissipated = law_.update(point, p);
     p.stress[i] = point.stress;
     zz = point.stress_zz;
