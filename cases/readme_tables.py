@@ -567,8 +567,28 @@ for name, written in [
     ("mpm benchmark math errno", "math-errno.csv"),
     ("mpm benchmark trapping math avx2", "trapping-math-avx2.csv"),
     ("mpm benchmark compiler options", "compiler-options.csv"),
+    ("mpm benchmark solver split", "solver-split.csv"),
+    ("mpm benchmark solver split 3d", "solver-split-3d.csv"),
 ]:
     block(name, "mpm_solid/benchmark/" + written)(mpm_benchmark_builds)
+
+
+@block("mpm benchmark point adapter", "mpm_solid/benchmark/point-adapter.csv")
+def point_adapter(rows):
+    """The elastic law written per material point (mpm_solid/materials/elastic_point.hpp) against the lane-wise
+    one, row by row in one run of scripts/compare-mpm-benchmark.py (--material elastic --material
+    elastic_point), a build measured twice: each build's ratio of the two rows' bests, per shape."""
+    builds = [h.removesuffix(" [particle-steps/s]") for h in rows[0] if h.endswith(" [particle-steps/s]")]
+    lines = on_host(rows) + ["| shape | " + " | ".join(f"elastic_point / elastic, {b}" for b in builds) + " |",
+                             "|---|" + "---|" * len(builds)]
+    for shape in dict.fromkeys(r["shape"] for r in rows):
+        rate = {r["material"]: r for r in rows if r["shape"] == shape}
+        if set(rate) != {"elastic", "elastic_point"}:
+            raise BlockError(f"{shape}: rows {sorted(rate)}, expected elastic and elastic_point")
+        ratios = [float(rate["elastic_point"][f"{b} [particle-steps/s]"]) / float(rate["elastic"][f"{b} [particle-steps/s]"])
+                  for b in builds]
+        lines.append(f"| {shape} | " + " | ".join(fixed(x, 2) for x in ratios) + " |")
+    return lines
 
 
 @block("outburst to rest parts", "cases/outburst/benchmark/outburst-to-rest-parts.csv")
