@@ -1,7 +1,9 @@
 #include "common/checkpoint.hpp"
 
 #include <omp.h>
+#include <zlib.h>
 
+#include <cmath>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -25,6 +27,12 @@ std::string joined(const std::vector<std::string>& lines) {
 
 const char* stage_name(Stage stage) { return stage == Stage::settling ? "settling" : "run"; }
 
+std::int64_t crc32_of(const void* data, std::size_t bytes) {
+  return static_cast<std::int64_t>(::crc32_z(0, static_cast<const Bytef*>(data), bytes));
+}
+
+const char* const checksum = "crc32";
+
 // The version string names a commit, but not edits made since, nor the
 // compiler and flags: only the same program file computes bit for bit alike.
 std::string build_fingerprint() {
@@ -47,26 +55,47 @@ void Fingerprint::add(const void* data, std::size_t bytes) {
   for (std::size_t i = 0; i < bytes; ++i) hash_ = (hash_ ^ byte[i]) * 1099511628211ull;
 }
 
-void Out::number(const std::string& name, double value) const { file_->write(path_ + "/" + name, &value, {1}); }
+void Out::number(const std::string& name, double value) const { write_rows(name, &value, 1, 0); }
 
-void Out::count(const std::string& name, std::int64_t value) const { file_->write(path_ + "/" + name, &value, {1}); }
+void Out::count(const std::string& name, std::int64_t value) const { write_counts(name, {value}); }
 
-void Out::text(const std::string& name, const std::string& value) const { file_->write_text(path_ + "/" + name, value); }
+void Out::text(const std::string& name, const std::string& value) const {
+  file_->write_text(path_ + "/" + name, value);
+  file_->attribute(path_ + "/" + name, checksum, crc32_of(value.data(), value.size()));
+}
 
 void Out::numbers(const std::string& name, const std::vector<double>& values) const {
-  file_->write(path_ + "/" + name, values.data(), {values.size()});
+  write_rows(name, values.data(), values.size(), 0);
 }
 
 void Out::numbers(const std::string& name, const Eigen::VectorXd& values) const {
-  file_->write(path_ + "/" + name, values.data(), {static_cast<std::size_t>(values.size())});
+  write_rows(name, values.data(), static_cast<std::size_t>(values.size()), 0);
+}
+
+void Out::write_rows(const std::string& name, const double* data, std::size_t rows, std::size_t columns) const {
+  file_->write(path_ + "/" + name, data, columns == 0 ? std::vector<std::size_t>{rows} : std::vector{rows, columns});
+  file_->attribute(path_ + "/" + name, checksum, crc32_of(data, rows * std::max<std::size_t>(columns, 1) * sizeof(double)));
 }
 
 void Out::write_counts(const std::string& name, const std::vector<std::int64_t>& values) const {
   file_->write(path_ + "/" + name, values.data(), {values.size()});
+  file_->attribute(path_ + "/" + name, checksum, crc32_of(values.data(), values.size() * sizeof(std::int64_t)));
 }
 
 void In::fail(const std::string& name, const std::string& what) const {
-  throw std::runtime_error(fmt::format("checkpoint {}: {}/{}: {}", name_.string(), path_, name, what));
+  throw scene::Error(fmt::format("--restart: checkpoint {}: dataset {}/{}: {}", name_.string(), path_, name, what));
+}
+
+bool In::has(const std::string& name) const {
+  return readable(name, [&] { return file_->exists(path_ + "/" + name); });
+}
+
+void In::verify(const std::string& name, const void* data, std::size_t bytes) const {
+  const auto written = readable(name, [&] { return file_->integer_attribute(path_ + "/" + name, checksum); });
+  if (!written) fail(name, "has no checksum (a \"crc32\" attribute): not a checkpoint of this version, or damaged");
+  if (*written != crc32_of(data, bytes))
+    fail(name, "its data do not match the checksum written with them: the checkpoint is damaged; continue from an "
+               "intact copy of it, or start afresh with --overwrite");
 }
 
 void In::refuse(const std::string& why) const { checkpoint::refuse(name_, why); }
@@ -80,7 +109,9 @@ std::int64_t In::count(const std::string& name) const { return read_counts(name,
 
 std::string In::text(const std::string& name) const {
   if (!has(name)) fail(name, "missing");
-  return file_->read_text(path_ + "/" + name);
+  auto text = readable(name, [&] { return file_->read_text(path_ + "/" + name); });
+  verify(name, text.data(), text.size());
+  return text;
 }
 
 std::vector<double> In::numbers(const std::string& name, std::optional<std::size_t> size) const {
@@ -94,20 +125,28 @@ Eigen::VectorXd In::vector(const std::string& name, std::optional<std::size_t> s
 
 std::vector<double> In::read_rows(const std::string& name, std::size_t columns, std::optional<std::size_t> rows) const {
   if (!has(name)) fail(name, "missing");
-  const auto shape = file_->shape(path_ + "/" + name);
+  const auto shape = readable(name, [&] { return file_->shape(path_ + "/" + name); });
   const std::size_t found_columns = shape.size() > 1 ? shape[1] : 1;
   if (shape.empty() || shape.size() > 2 || found_columns != columns)
     fail(name, fmt::format("expected {} value(s) per row", columns));
   if (rows && shape[0] != *rows) fail(name, fmt::format("holds {} rows, this run's state has {}", shape[0], *rows));
-  return file_->read_doubles(path_ + "/" + name);
+  auto values = readable(name, [&] { return file_->read_doubles(path_ + "/" + name); });
+  verify(name, values.data(), values.size() * sizeof(double));
+  for (std::size_t i = 0; i < values.size(); ++i)
+    if (!std::isfinite(values[i]))
+      fail(name, fmt::format("holds {} in row {}, where a run's state is finite: the checkpoint is damaged", values[i],
+                             i / columns));
+  return values;
 }
 
 std::vector<std::int64_t> In::read_counts(const std::string& name, std::optional<std::size_t> size) const {
   if (!has(name)) fail(name, "missing");
-  const auto shape = file_->shape(path_ + "/" + name);
+  const auto shape = readable(name, [&] { return file_->shape(path_ + "/" + name); });
   if (shape.size() != 1) fail(name, "expected a list of integers");
   if (size && shape[0] != *size) fail(name, fmt::format("holds {} values, this run's state has {}", shape[0], *size));
-  return file_->read_integers(path_ + "/" + name);
+  auto values = readable(name, [&] { return file_->read_integers(path_ + "/" + name); });
+  verify(name, values.data(), values.size() * sizeof(std::int64_t));
+  return values;
 }
 
 void save_length(Out out, const std::string& name, const std::filesystem::path& file) {
@@ -127,7 +166,7 @@ void cut_back(const In& in, const std::string& name, const std::filesystem::path
 }
 
 Writer::Writer(const std::filesystem::path& directory, const output::RunInfo& info, Stage stage)
-    : file_(directory / file_name) {
+    : file_(directory / file_name, hdf5::H5Writer::Metadata::checksummed) {
   file_.attribute("/", "program", info.program);
   file_.attribute("/", "version", info.version);
   file_.attribute("/", "build", build_fingerprint());
@@ -178,7 +217,15 @@ Reader::Reader(const std::filesystem::path& directory, const output::RunInfo& in
     stage_ = Stage::settling;
   else if (stage != stage_name(Stage::run))
     refuse(fmt::format("unknown stage '{}'", stage));
-  const int threads = static_cast<int>(file_->number_attribute("/", "threads"));
+  double written_threads = 0;
+  try {
+    written_threads = file_->number_attribute("/", "threads");
+  } catch (const hdf5::Error&) {
+    refuse("not a checkpoint (no attribute 'threads')");
+  }
+  if (!(written_threads >= 1 && written_threads <= 1 << 20))
+    refuse(fmt::format("written with {} threads, which no run has", written_threads));
+  const int threads = static_cast<int>(written_threads);
   if (threads != omp_get_max_threads())
     spdlog::warn("--restart: the checkpoint was written with {} threads, this run has {}: the run continues "
                  "correctly, but not bit for bit as it would have with {} (README.md, Checkpoints and restart)",
