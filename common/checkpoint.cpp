@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "common/atomic_file.hpp"
 #include "common/scene.hpp"
 
 namespace outburst::checkpoint {
@@ -150,7 +151,12 @@ std::vector<std::int64_t> In::read_counts(const std::string& name, std::optional
 }
 
 void save_length(Out out, const std::string& name, const std::filesystem::path& file) {
-  out.count(name, static_cast<std::int64_t>(std::filesystem::file_size(file)));
+  std::error_code error;
+  const auto length = std::filesystem::file_size(file, error);
+  if (error)
+    throw std::runtime_error(fmt::format("cannot read the length of {} for the checkpoint: {}{}", file.string(),
+                                         error.message(), output::disk_note(file)));
+  out.count(name, static_cast<std::int64_t>(length));
 }
 
 void cut_back(const In& in, const std::string& name, const std::filesystem::path& file, std::ofstream& stream) {

@@ -14,6 +14,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "common/atomic_file.hpp"
 #include "common/checkpoint.hpp"
 #include "common/scene.hpp"
 
@@ -42,6 +43,16 @@ std::string holder(int fd) {
   throw scene::Error(fmt::format("output folder {}: {}", directory.string(), why));
 }
 
+// A folder the run cannot write: exit code 1 on a full disk (the run could
+// not go on), 2 for a folder it may not write (the command line's -o).
+[[noreturn]] void cannot_write(const std::filesystem::path& directory, const std::string& what, int error) {
+  const std::string why = fmt::format("{}: {}", what, std::strerror(error));
+  if (output::out_of_space(error))
+    throw std::runtime_error(
+        fmt::format("output folder {}: {}{}", directory.string(), why, output::disk_note(directory / "-")));
+  refuse(directory, why);
+}
+
 }  // namespace
 
 OutputFolder::OutputFolder(std::filesystem::path directory, const std::string& program, Earlier earlier_files)
@@ -53,10 +64,10 @@ OutputFolder::OutputFolder(std::filesystem::path directory, const std::string& p
     refuse(directory_, "--restart: there is no such folder, so no run to continue; give the folder of the stopped "
                        "run with -o, or run without --restart");
   std::filesystem::create_directories(directory_, error);
-  if (error) refuse(directory_, fmt::format("cannot create it: {}", error.message()));
+  if (error) cannot_write(directory_, "cannot create it", error.value());
 
   int fd = ::open((directory_ / ".run.lock").c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-  if (fd < 0) refuse(directory_, fmt::format("cannot write in it: {}", std::strerror(errno)));
+  if (fd < 0) cannot_write(directory_, "cannot write in it", errno);
   // Closing the lock file releases the lock: done here unless the folder is taken.
   struct Closer {
     int& fd;
@@ -100,7 +111,7 @@ OutputFolder::OutputFolder(std::filesystem::path directory, const std::string& p
                                          fmt::localtime(std::chrono::system_clock::to_time_t(
                                              std::chrono::system_clock::now())));
   if (::ftruncate(fd, 0) != 0 || ::pwrite(fd, record.data(), record.size(), 0) < 0)
-    refuse(directory_, fmt::format("cannot write its lock file: {}", std::strerror(errno)));
+    cannot_write(directory_, "cannot write its lock file", errno);
   lock_ = std::exchange(fd, -1);
 }
 

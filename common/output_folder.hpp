@@ -11,7 +11,8 @@
 // run's later snapshots would stay beside the new run's. A restart keeps them
 // (the run continues them from its checkpoint) but for the temporary files a
 // killed run left, and refuses a folder that does not exist.
-// Errors are scene::Error (bad command line: exit code 2).
+// Errors are scene::Error (bad command line: exit code 2), but for a full
+// disk (std::runtime_error: exit code 1).
 
 #include <filesystem>
 #include <string>

@@ -3,7 +3,9 @@
 lives is refused naming it (program, pid, start time); once the first is
 killed (kill -9) its stale lock blocks nothing, but its files are replaced
 only with --overwrite, which removes the earlier run's extra snapshots; -o
-naming a file is refused with exit code 2.
+naming a file is refused with exit code 2. A folder removed while a run
+writes there stops the run with exit code 1, saying so (before: "0 MB free
+on its disk").
 
 usage: output_folder.py MPM_SOLID SCENE WORK_DIR"""
 import os
@@ -50,6 +52,20 @@ def main():
     print(f"after the rerun: {len(snapshots)} snapshots")
     if len(snapshots) != 11:  # the scene's end_time / interval + the initial one
         failures.append(f"{len(snapshots)} snapshots after --overwrite, expected the rerun's 11 alone")
+
+    # The folder removed while the run writes there.
+    gone = os.path.join(work, "gone")
+    second = subprocess.Popen([program, scene, "-q", "-o", gone, "--set", 'scene.end_time="10 s"', "--set",
+                               'output.interval="0.001 s"'], stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 60
+    while not os.path.exists(os.path.join(gone, "particles_000003.h5")) and time.monotonic() < deadline:
+        time.sleep(0.02)
+    shutil.rmtree(gone)
+    _, stderr = second.communicate(timeout=60)
+    last = stderr.strip().splitlines()[-1] if stderr.strip() else ""
+    expect("the folder removed mid-run", (second.returncode, last), 1, f"the folder {gone} no longer exists")
+    if "MB free" in last or "filesystem error" in last:
+        failures.append(f"the folder removed mid-run: '{last}'")
 
     a_file = os.path.join(work, "a_file")
     open(a_file, "w").close()
