@@ -10,6 +10,8 @@
 
 #include <fmt/format.h>
 
+#include "common/manifest.hpp"
+
 namespace outburst::output {
 
 std::string disk_note(const std::filesystem::path& path) {
@@ -29,6 +31,7 @@ void fail_to_write(const std::filesystem::path& path, int error) {
 bool out_of_space(int error) { return error == ENOSPC || error == EDQUOT || error == EFBIG; }
 
 std::filesystem::path write_beside(const std::filesystem::path& path, std::string_view bytes) {
+  record_written(path);
   std::filesystem::path temp = path;
   temp += fmt::format(".partial-{}", ::getpid());
   const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);

@@ -10,6 +10,7 @@
 #include <spdlog/spdlog.h>
 
 #include "common/atomic_file.hpp"
+#include "common/manifest.hpp"
 #include "common/scene.hpp"
 
 namespace outburst::checkpoint {
@@ -166,7 +167,9 @@ void cut_back(const In& in, const std::string& name, const std::filesystem::path
   if (error || now < length)
     in.fail(name, fmt::format("{} holds {} bytes, fewer than the {} it held at the checkpoint: it was changed since",
                               file.string(), error ? 0 : now, length));
-  std::filesystem::resize_file(file, length);
+  std::filesystem::resize_file(file, length, error);
+  if (error) in.fail(name, fmt::format("cannot cut {} back to {} bytes: {}", file.string(), length, error.message()));
+  output::record_written(file);
   stream.open(file, std::ios::app);
   if (!stream) in.fail(name, fmt::format("cannot open {} to append to it", file.string()));
 }
