@@ -29,7 +29,7 @@ std::string read_text(const std::filesystem::path& file) {
 
 std::string node_text(const toml::node& n) {
   if (const auto* s = n.as_string()) return s->get();
-  if (const auto* f = n.as_floating_point()) return fmt::format("{:.12g}", f->get());
+  if (const auto* f = n.as_floating_point()) return fmt::format("{}", f->get());  // shortest, and exact
   std::ostringstream out;
   n.visit([&](const auto& v) { out << v; });
   return out.str();
