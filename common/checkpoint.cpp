@@ -29,6 +29,16 @@ std::string joined(const std::vector<std::string>& lines) {
 
 const char* stage_name(Stage stage) { return stage == Stage::settling ? "settling" : "run"; }
 
+// Text read from a checkpoint, for a message: a damaged one may hold any
+// byte, shown as \xNN but for printable ASCII and newlines.
+std::string shown(const std::string& text) {
+  std::string out;
+  for (const char c : text)
+    out += (c >= 0x20 && c < 0x7f) || c == '\n' ? std::string(1, c)
+                                                : fmt::format("\\x{:02x}", static_cast<unsigned char>(c));
+  return out;
+}
+
 std::int64_t crc32_of(const void* data, std::size_t bytes) {
   return static_cast<std::int64_t>(::crc32_z(0, static_cast<const Bytef*>(data), bytes));
 }
@@ -204,12 +214,12 @@ Reader::Reader(const std::filesystem::path& directory, const output::RunInfo& in
     }
   };
   if (const auto program = attribute("program"); program != info.program)
-    refuse(fmt::format("written by {}, not {}", program, info.program));
+    refuse(fmt::format("written by {}, not {}", shown(program), info.program));
   // Only the same build continues a run bit for bit: another version may
   // compute differently or keep other state.
   if (const auto version = attribute("version"); version != info.version)
     refuse(fmt::format("written by version {}, this is {}; finish the run with that build, or start afresh",
-                       version, info.version));
+                       shown(version), info.version));
   if (attribute("build") != build_fingerprint())
     refuse(fmt::format("written by another build of version {} (the program file differs: rebuilt since, or "
                        "another build folder); finish the run with that build, or start afresh",
@@ -221,11 +231,11 @@ Reader::Reader(const std::filesystem::path& directory, const output::RunInfo& in
     refuse(fmt::format("written for another scene text (the scene file {} changed since)", info.scene_file));
   if (const auto overrides = attribute("scene_overrides"); overrides != joined(info.overrides))
     refuse(fmt::format("written with other --set overrides: [{}]; give the same ones",
-                       overrides.empty() ? "none" : overrides.substr(0, overrides.size() - 1)));
+                       overrides.empty() ? "none" : shown(overrides.substr(0, overrides.size() - 1))));
   if (const auto stage = attribute("stage"); stage == stage_name(Stage::settling))
     stage_ = Stage::settling;
   else if (stage != stage_name(Stage::run))
-    refuse(fmt::format("unknown stage '{}'", stage));
+    refuse(fmt::format("unknown stage '{}'", shown(stage)));
   double written_threads = 0;
   try {
     written_threads = file_->number_attribute("/", "threads");
