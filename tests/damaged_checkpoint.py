@@ -3,8 +3,9 @@
 the dataset: a byte flipped in a dataset's data (its CRC-32 no longer
 matches) or in the file's structure (HDF5's metadata checksums), a checksum
 missing, and values no run holds written with a matching checksum (as an
-edit would): a NaN velocity, pressure or position, a negative particle id or
-one given twice, a coupling slice past the end of its vector. An intact copy
+edit would): a NaN velocity or an infinite pressure, a negative particle id
+or one given twice, a particle mass or a cell's conductivity of 0, a
+coupling slice past the end of its vector. An intact copy
 of each checkpoint restarts (exit code 0). Before (issue 57): every one of
 these restarted with exit code 0, or failed later, blamed on the time step.
 
@@ -105,6 +106,8 @@ CASES = [
      ["checkpoint.h5", "dataset /seepage/u", "do not match the checksum"]),
     ("an infinite pressure", "seepage", edit("seepage/u", setitem(10, np.inf)),
      ["checkpoint.h5", "dataset /seepage/u", "holds inf in row 10"]),
+    ("a conductivity of 0", "seepage", edit("seepage/conductivity", setitem(4, 0.0)),
+     ["checkpoint.h5", "dataset /seepage/conductivity", "cell 4 has the conductivity 0"]),
     ("a bit flipped in the coupled run's positions", "coupled", flip_data("model/mpm/particles/x", 8 * 11 + 7),
      ["checkpoint.h5", "dataset /model/mpm/particles/x", "do not match the checksum"]),
     ("a coupling slice past the end of its vector", "coupled",
