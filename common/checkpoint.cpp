@@ -1,12 +1,16 @@
 #include "common/checkpoint.hpp"
 
 #include <omp.h>
+#include <zlib.h>
 
+#include <cmath>
 #include <stdexcept>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "common/atomic_file.hpp"
+#include "common/manifest.hpp"
 #include "common/scene.hpp"
 
 namespace outburst::checkpoint {
@@ -24,6 +28,22 @@ std::string joined(const std::vector<std::string>& lines) {
 }
 
 const char* stage_name(Stage stage) { return stage == Stage::settling ? "settling" : "run"; }
+
+// Text read from a checkpoint, for a message: a damaged one may hold any
+// byte, shown as \xNN but for printable ASCII and newlines.
+std::string shown(const std::string& text) {
+  std::string out;
+  for (const char c : text)
+    out += (c >= 0x20 && c < 0x7f) || c == '\n' ? std::string(1, c)
+                                                : fmt::format("\\x{:02x}", static_cast<unsigned char>(c));
+  return out;
+}
+
+std::int64_t crc32_of(const void* data, std::size_t bytes) {
+  return static_cast<std::int64_t>(::crc32_z(0, static_cast<const Bytef*>(data), bytes));
+}
+
+const char* const checksum = "crc32";
 
 // The version string names a commit, but not edits made since, nor the
 // compiler and flags: only the same program file computes bit for bit alike.
@@ -47,26 +67,47 @@ void Fingerprint::add(const void* data, std::size_t bytes) {
   for (std::size_t i = 0; i < bytes; ++i) hash_ = (hash_ ^ byte[i]) * 1099511628211ull;
 }
 
-void Out::number(const std::string& name, double value) const { file_->write(path_ + "/" + name, &value, {1}); }
+void Out::number(const std::string& name, double value) const { write_rows(name, &value, 1, 0); }
 
-void Out::count(const std::string& name, std::int64_t value) const { file_->write(path_ + "/" + name, &value, {1}); }
+void Out::count(const std::string& name, std::int64_t value) const { write_counts(name, {value}); }
 
-void Out::text(const std::string& name, const std::string& value) const { file_->write_text(path_ + "/" + name, value); }
+void Out::text(const std::string& name, const std::string& value) const {
+  file_->write_text(path_ + "/" + name, value);
+  file_->attribute(path_ + "/" + name, checksum, crc32_of(value.data(), value.size()));
+}
 
 void Out::numbers(const std::string& name, const std::vector<double>& values) const {
-  file_->write(path_ + "/" + name, values.data(), {values.size()});
+  write_rows(name, values.data(), values.size(), 0);
 }
 
 void Out::numbers(const std::string& name, const Eigen::VectorXd& values) const {
-  file_->write(path_ + "/" + name, values.data(), {static_cast<std::size_t>(values.size())});
+  write_rows(name, values.data(), static_cast<std::size_t>(values.size()), 0);
+}
+
+void Out::write_rows(const std::string& name, const double* data, std::size_t rows, std::size_t columns) const {
+  file_->write(path_ + "/" + name, data, columns == 0 ? std::vector<std::size_t>{rows} : std::vector{rows, columns});
+  file_->attribute(path_ + "/" + name, checksum, crc32_of(data, rows * std::max<std::size_t>(columns, 1) * sizeof(double)));
 }
 
 void Out::write_counts(const std::string& name, const std::vector<std::int64_t>& values) const {
   file_->write(path_ + "/" + name, values.data(), {values.size()});
+  file_->attribute(path_ + "/" + name, checksum, crc32_of(values.data(), values.size() * sizeof(std::int64_t)));
 }
 
 void In::fail(const std::string& name, const std::string& what) const {
-  throw std::runtime_error(fmt::format("checkpoint {}: {}/{}: {}", name_.string(), path_, name, what));
+  throw scene::Error(fmt::format("--restart: checkpoint {}: dataset {}/{}: {}", name_.string(), path_, name, what));
+}
+
+bool In::has(const std::string& name) const {
+  return readable(name, [&] { return file_->exists(path_ + "/" + name); });
+}
+
+void In::verify(const std::string& name, const void* data, std::size_t bytes) const {
+  const auto written = readable(name, [&] { return file_->integer_attribute(path_ + "/" + name, checksum); });
+  if (!written) fail(name, "has no checksum (a \"crc32\" attribute): not a checkpoint of this version, or damaged");
+  if (*written != crc32_of(data, bytes))
+    fail(name, "its data do not match the checksum written with them: the checkpoint is damaged; continue from an "
+               "intact copy of it, or start afresh with --overwrite");
 }
 
 void In::refuse(const std::string& why) const { checkpoint::refuse(name_, why); }
@@ -80,7 +121,9 @@ std::int64_t In::count(const std::string& name) const { return read_counts(name,
 
 std::string In::text(const std::string& name) const {
   if (!has(name)) fail(name, "missing");
-  return file_->read_text(path_ + "/" + name);
+  auto text = readable(name, [&] { return file_->read_text(path_ + "/" + name); });
+  verify(name, text.data(), text.size());
+  return text;
 }
 
 std::vector<double> In::numbers(const std::string& name, std::optional<std::size_t> size) const {
@@ -94,24 +137,37 @@ Eigen::VectorXd In::vector(const std::string& name, std::optional<std::size_t> s
 
 std::vector<double> In::read_rows(const std::string& name, std::size_t columns, std::optional<std::size_t> rows) const {
   if (!has(name)) fail(name, "missing");
-  const auto shape = file_->shape(path_ + "/" + name);
+  const auto shape = readable(name, [&] { return file_->shape(path_ + "/" + name); });
   const std::size_t found_columns = shape.size() > 1 ? shape[1] : 1;
   if (shape.empty() || shape.size() > 2 || found_columns != columns)
     fail(name, fmt::format("expected {} value(s) per row", columns));
   if (rows && shape[0] != *rows) fail(name, fmt::format("holds {} rows, this run's state has {}", shape[0], *rows));
-  return file_->read_doubles(path_ + "/" + name);
+  auto values = readable(name, [&] { return file_->read_doubles(path_ + "/" + name); });
+  verify(name, values.data(), values.size() * sizeof(double));
+  for (std::size_t i = 0; i < values.size(); ++i)
+    if (!std::isfinite(values[i]))
+      fail(name, fmt::format("holds {} in row {}, where a run's state is finite: the checkpoint is damaged", values[i],
+                             i / columns));
+  return values;
 }
 
 std::vector<std::int64_t> In::read_counts(const std::string& name, std::optional<std::size_t> size) const {
   if (!has(name)) fail(name, "missing");
-  const auto shape = file_->shape(path_ + "/" + name);
+  const auto shape = readable(name, [&] { return file_->shape(path_ + "/" + name); });
   if (shape.size() != 1) fail(name, "expected a list of integers");
   if (size && shape[0] != *size) fail(name, fmt::format("holds {} values, this run's state has {}", shape[0], *size));
-  return file_->read_integers(path_ + "/" + name);
+  auto values = readable(name, [&] { return file_->read_integers(path_ + "/" + name); });
+  verify(name, values.data(), values.size() * sizeof(std::int64_t));
+  return values;
 }
 
 void save_length(Out out, const std::string& name, const std::filesystem::path& file) {
-  out.count(name, static_cast<std::int64_t>(std::filesystem::file_size(file)));
+  std::error_code error;
+  const auto length = std::filesystem::file_size(file, error);
+  if (error)
+    throw std::runtime_error(fmt::format("cannot read the length of {} for the checkpoint: {}{}", file.string(),
+                                         error.message(), output::disk_note(file)));
+  out.count(name, static_cast<std::int64_t>(length));
 }
 
 void cut_back(const In& in, const std::string& name, const std::filesystem::path& file, std::ofstream& stream) {
@@ -121,13 +177,15 @@ void cut_back(const In& in, const std::string& name, const std::filesystem::path
   if (error || now < length)
     in.fail(name, fmt::format("{} holds {} bytes, fewer than the {} it held at the checkpoint: it was changed since",
                               file.string(), error ? 0 : now, length));
-  std::filesystem::resize_file(file, length);
+  std::filesystem::resize_file(file, length, error);
+  if (error) in.fail(name, fmt::format("cannot cut {} back to {} bytes: {}", file.string(), length, error.message()));
+  output::record_written(file);
   stream.open(file, std::ios::app);
   if (!stream) in.fail(name, fmt::format("cannot open {} to append to it", file.string()));
 }
 
 Writer::Writer(const std::filesystem::path& directory, const output::RunInfo& info, Stage stage)
-    : file_(directory / file_name) {
+    : file_(directory / file_name, hdf5::H5Writer::Metadata::checksummed) {
   file_.attribute("/", "program", info.program);
   file_.attribute("/", "version", info.version);
   file_.attribute("/", "build", build_fingerprint());
@@ -156,12 +214,12 @@ Reader::Reader(const std::filesystem::path& directory, const output::RunInfo& in
     }
   };
   if (const auto program = attribute("program"); program != info.program)
-    refuse(fmt::format("written by {}, not {}", program, info.program));
+    refuse(fmt::format("written by {}, not {}", shown(program), info.program));
   // Only the same build continues a run bit for bit: another version may
   // compute differently or keep other state.
   if (const auto version = attribute("version"); version != info.version)
     refuse(fmt::format("written by version {}, this is {}; finish the run with that build, or start afresh",
-                       version, info.version));
+                       shown(version), info.version));
   if (attribute("build") != build_fingerprint())
     refuse(fmt::format("written by another build of version {} (the program file differs: rebuilt since, or "
                        "another build folder); finish the run with that build, or start afresh",
@@ -173,12 +231,20 @@ Reader::Reader(const std::filesystem::path& directory, const output::RunInfo& in
     refuse(fmt::format("written for another scene text (the scene file {} changed since)", info.scene_file));
   if (const auto overrides = attribute("scene_overrides"); overrides != joined(info.overrides))
     refuse(fmt::format("written with other --set overrides: [{}]; give the same ones",
-                       overrides.empty() ? "none" : overrides.substr(0, overrides.size() - 1)));
+                       overrides.empty() ? "none" : shown(overrides.substr(0, overrides.size() - 1))));
   if (const auto stage = attribute("stage"); stage == stage_name(Stage::settling))
     stage_ = Stage::settling;
   else if (stage != stage_name(Stage::run))
-    refuse(fmt::format("unknown stage '{}'", stage));
-  const int threads = static_cast<int>(file_->number_attribute("/", "threads"));
+    refuse(fmt::format("unknown stage '{}'", shown(stage)));
+  double written_threads = 0;
+  try {
+    written_threads = file_->number_attribute("/", "threads");
+  } catch (const hdf5::Error&) {
+    refuse("not a checkpoint (no attribute 'threads')");
+  }
+  if (!(written_threads >= 1 && written_threads <= 1 << 20))
+    refuse(fmt::format("written with {} threads, which no run has", written_threads));
+  const int threads = static_cast<int>(written_threads);
   if (threads != omp_get_max_threads())
     spdlog::warn("--restart: the checkpoint was written with {} threads, this run has {}: the run continues "
                  "correctly, but not bit for bit as it would have with {} (README.md, Checkpoints and restart)",

@@ -11,6 +11,11 @@
 // overrides; a restart by another program or build, or with another scene, is
 // refused (scene::Error: exit code 2).
 //
+// A damaged checkpoint is refused too, naming the file and the dataset: its
+// metadata carries HDF5's checksums, each dataset a CRC-32 (zlib's) of its
+// bytes as written (little-endian, in a "crc32" attribute), and each number
+// read back must be finite, as every number of a run's state is.
+//
 // A checkpoint holds one of two stages: the settling stage of an MPM solid
 // (before t = 0, no output written yet), or the run itself.
 
@@ -21,9 +26,11 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
+#include <fmt/format.h>
 
 #include "common/field_output.hpp"
 #include "common/hdf5_file.hpp"
@@ -69,10 +76,12 @@ class Out {
   // Fixed-size Eigen vectors and matrices, one row of R * C values each.
   template <int R, int C>
   void matrices(const std::string& name, const std::vector<Eigen::Matrix<double, R, C>>& values) const {
-    file_->write(path_ + "/" + name, values.empty() ? nullptr : values.front().data(), {values.size(), R * C});
+    write_rows(name, values.empty() ? nullptr : values.front().data(), values.size(), R * C);
   }
 
  private:
+  // columns 0: a list (a dataset of one dimension).
+  void write_rows(const std::string& name, const double* data, std::size_t rows, std::size_t columns) const;
   void write_counts(const std::string& name, const std::vector<std::int64_t>& values) const;
   hdf5::H5Writer* file_;
   std::string path_;
@@ -85,7 +94,7 @@ class In {
   In(const hdf5::H5Reader& file, std::filesystem::path name, std::string path)
       : file_(&file), name_(std::move(name)), path_(std::move(path)) {}
   In group(const std::string& name) const { return {*file_, name_, path_ + "/" + name}; }
-  bool has(const std::string& name) const { return file_->exists(path_ + "/" + name); }
+  bool has(const std::string& name) const;
 
   double number(const std::string& name) const;
   std::int64_t count(const std::string& name) const;
@@ -97,6 +106,9 @@ class In {
   template <std::integral Int>
   std::vector<Int> counts(const std::string& name, std::optional<std::size_t> size = {}) const {
     const auto values = read_counts(name, size);
+    for (std::size_t i = 0; i < values.size(); ++i)
+      if (!std::in_range<Int>(values[i]))
+        fail(name, fmt::format("holds {} in row {}, beyond the integers this state holds there", values[i], i));
     return {values.begin(), values.end()};
   }
   template <int R, int C>
@@ -108,7 +120,8 @@ class In {
       values[i] = Eigen::Map<const Eigen::Matrix<double, R, C>>(flat.data() + i * R * C);
     return values;
   }
-  // A std::runtime_error naming the file and the dataset: a damaged checkpoint.
+  // A scene::Error (exit code 2) naming the file and the dataset: a damaged
+  // checkpoint.
   [[noreturn]] void fail(const std::string& name, const std::string& what) const;
   // A scene::Error (exit code 2) naming the file: a checkpoint of another
   // input than this run's.
@@ -117,6 +130,18 @@ class In {
  private:
   std::vector<std::int64_t> read_counts(const std::string& name, std::optional<std::size_t> size) const;
   std::vector<double> read_rows(const std::string& name, std::size_t columns, std::optional<std::size_t> rows) const;
+  // Refuses data other than the bytes written under `name`.
+  void verify(const std::string& name, const void* data, std::size_t bytes) const;
+  // read(), with what the HDF5 library could not read (a damaged structure:
+  // its metadata checksums) refused as a damaged `name`.
+  template <class Read>
+  auto readable(const std::string& name, Read&& read) const -> decltype(read()) {
+    try {
+      return read();
+    } catch (const hdf5::Error& e) {
+      fail(name, fmt::format("cannot read it: the checkpoint is damaged ({})", e.what()));
+    }
+  }
   const hdf5::H5Reader* file_;
   std::filesystem::path name_;
   std::string path_;

@@ -12,16 +12,49 @@ namespace outburst::output {
 
 namespace {
 
+// The length of the UTF-8 sequence at s[i] of a character XML 1.0 may hold
+// (U+0020 and up but DEL, no surrogates, not U+FFFE or U+FFFF), or 0.
+std::size_t xml_character(const std::string& s, std::size_t i) {
+  const auto byte = [&](std::size_t k) { return k < s.size() ? static_cast<unsigned char>(s[k]) : 0u; };
+  const auto continues = [&](std::size_t k, unsigned lo = 0x80, unsigned hi = 0xBF) {
+    return byte(k) >= lo && byte(k) <= hi;
+  };
+  const unsigned b = byte(i);
+  if (b >= 0x20 && b < 0x7F) return 1;
+  if (b >= 0xC2 && b <= 0xDF) return continues(i + 1) ? 2 : 0;
+  if (b >= 0xE0 && b <= 0xEF) {
+    const bool ok = continues(i + 1, b == 0xE0 ? 0xA0 : 0x80, b == 0xED ? 0x9F : 0xBF) && continues(i + 2);
+    const bool not_a_character = b == 0xEF && byte(i + 1) == 0xBF && byte(i + 2) >= 0xBE;
+    return ok && !not_a_character ? 3 : 0;
+  }
+  if (b >= 0xF0 && b <= 0xF4)
+    return continues(i + 1, b == 0xF0 ? 0x90 : 0x80, b == 0xF4 ? 0x8F : 0xBF) && continues(i + 2) &&
+                   continues(i + 3)
+               ? 4
+               : 0;
+  return 0;
+}
+
+// Text for an XML attribute value: markup escaped, and each byte XML cannot
+// hold (control characters, bytes that are not UTF-8, as a path may have) and
+// '%' percent-encoded ("%FF"), so the text reads back, byte for byte, by
+// decoding what ParaView shows.
 std::string xml_escape(const std::string& s) {
   std::string out;
-  for (char c : s) {
-    switch (c) {
+  for (std::size_t i = 0; i < s.size();) {
+    const std::size_t length = s[i] == '%' ? 0 : xml_character(s, i);
+    if (length == 0) {
+      out += fmt::format("%{:02X}", static_cast<unsigned char>(s[i++]));
+      continue;
+    }
+    switch (s[i]) {
       case '&': out += "&amp;"; break;
       case '<': out += "&lt;"; break;
       case '>': out += "&gt;"; break;
       case '"': out += "&quot;"; break;
-      default: out += c;
+      default: out.append(s, i, length);
     }
+    i += length;
   }
   return out;
 }

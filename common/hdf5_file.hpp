@@ -5,17 +5,31 @@
 // writes it under a temporary name beside the target and renames it into
 // place. A run that dies mid-write, or finds its disk full, leaves the
 // previous complete file (or none), never a truncated one.
+//
+// A file written with checksummed metadata (HDF5's 1.8 format on: superblock,
+// object headers and heaps carry checksums, which the library verifies as it
+// reads them) refuses a damaged structure before parsing it; its data, the
+// writer's own checksums cover (checkpoint.hpp).
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 namespace outburst::hdf5 {
 
+// What the library could not do with a file, naming it.
+class Error : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 class H5Writer {
  public:
-  explicit H5Writer(std::filesystem::path final_path);
+  enum class Metadata { compatible, checksummed };
+  explicit H5Writer(std::filesystem::path final_path, Metadata metadata = Metadata::compatible);
   ~H5Writer();
   H5Writer(const H5Writer&) = delete;
   H5Writer& operator=(const H5Writer&) = delete;
@@ -35,6 +49,7 @@ class H5Writer {
   // String and number attributes on the root group ("/") or an existing object.
   void attribute(const std::string& object, const std::string& name, const std::string& value);
   void attribute(const std::string& object, const std::string& name, double value);
+  void attribute(const std::string& object, const std::string& name, std::int64_t value);
 
   // Close the file and move it to its final name.
   void commit();
@@ -60,6 +75,8 @@ class H5Reader {
   std::string read_text(const std::string& path) const;
   std::string string_attribute(const std::string& object, const std::string& name) const;
   double number_attribute(const std::string& object, const std::string& name) const;
+  // Empty when the object has no such attribute.
+  std::optional<std::int64_t> integer_attribute(const std::string& object, const std::string& name) const;
 
  private:
   std::filesystem::path path_;

@@ -5,13 +5,17 @@
 // and names that run (program, pid, start time). The kernel releases the
 // lock when the process ends, even by kill -9, so a stale lock never blocks.
 // A second run into a folder whose run is still going is refused, naming it.
-// A run into a folder holding an earlier run's files (the XDMF indexes and
-// HDF5 files, the history CSVs, temporary .partial- files) is refused unless
-// asked to overwrite them, which removes them first: otherwise an earlier
-// run's later snapshots would stay beside the new run's. A restart keeps them
-// (the run continues them from its checkpoint) but for the temporary files a
-// killed run left, and refuses a folder that does not exist.
-// Errors are scene::Error (bad command line: exit code 2).
+// Each run lists the files it writes in the folder's manifest (manifest.hpp).
+// A run into a folder holding an earlier run's files is refused unless asked
+// to overwrite them, which removes them first: otherwise an earlier run's
+// later snapshots would stay beside the new run's. Files that look like a
+// run's output (HDF5, XDMF, the history CSVs, temporary .partial- files) but
+// that no manifest lists, such as a user's data, are never removed: a run into
+// such a folder, --overwrite or not, is refused, naming them. A restart keeps
+// the earlier run's files (the run continues them from its checkpoint) but for
+// the temporary files a killed run left, and refuses a folder that does not
+// exist. Errors are scene::Error (bad command line: exit code 2), but for a
+// full disk (std::runtime_error: exit code 1).
 
 #include <filesystem>
 #include <string>

@@ -69,8 +69,9 @@ SceneHeader read_scene_header(const scene::Table& root) {
   }
   h.checkpoint_interval = h.output_interval;
   if (o) {
-    // Read even when absent, so that --explain lists it with its default.
-    const std::string every_snapshot = fmt::format("{:.17g} s", h.output_interval);
+    // Read even when absent, so that --explain lists it with its default, in
+    // the shortest form that reads back as the same number.
+    const std::string every_snapshot = fmt::format("{} s", h.output_interval);
     h.checkpoint_interval = o->quantity({"checkpoint_interval",
                                          "simulated time between checkpoints (the run's whole state in "
                                          "checkpoint.h5), from which --restart continues a stopped run; a "

@@ -29,7 +29,7 @@ std::string read_text(const std::filesystem::path& file) {
 
 std::string node_text(const toml::node& n) {
   if (const auto* s = n.as_string()) return s->get();
-  if (const auto* f = n.as_floating_point()) return fmt::format("{:.12g}", f->get());
+  if (const auto* f = n.as_floating_point()) return fmt::format("{}", f->get());  // shortest, and exact
   std::ostringstream out;
   n.visit([&](const auto& v) { out << v; });
   return out.str();
@@ -126,6 +126,187 @@ std::string join(const std::vector<std::string_view>& words) {
   return s;
 }
 
+// How deep a scene's keys and values may nest: tables of tables (counting
+// each part of a dotted key or header), arrays and inline tables. Scenes need
+// a handful of levels; toml++ parses nesting by recursion, as do the readers
+// here, and a 70 kB scene of one 35,000-part dotted key overflowed the stack.
+constexpr int max_depth = 32;
+
+// Refuses text nested deeper than max_depth, before toml++ sees it. A scan of
+// TOML's lexical structure (strings, comments, keys, headers, arrays, inline
+// tables), not a parser: what it does not follow it skips, so it always reaches
+// the end, and leaves syntax errors to toml++. A --set value comes as "v =
+// <value>", and is named by its `override_key` instead.
+void check_depth(std::string_view text, const std::string& name, std::string_view override_key = {}) {
+  std::size_t i = 0, line = 1, line_start = 0;
+  const std::size_t n = text.size();
+  const auto at = [&](std::size_t k) { return k < n ? text[k] : '\0'; };
+  // `depth`: how deep the key goes, or (`at_least`) where the scan stopped.
+  const auto refuse = [&](std::size_t start, std::size_t key_start, std::size_t key_stop, int depth,
+                          bool at_least = false) {
+    std::string key(override_key.empty() ? text.substr(key_start, std::min<std::size_t>(key_stop - key_start, 60))
+                                         : override_key);
+    if (override_key.empty() && key_stop - key_start > 60) key += "...";
+    const std::string where =
+        override_key.empty() ? fmt::format("{}:{}:{}", name, line, start - line_start + 1) : name;
+    throw Error(fmt::format("{}: key '{}': nested {}{} levels deep (each table, part of a dotted key, array and "
+                            "inline table is a level); a scene may nest at most {}",
+                            where, key, depth, at_least ? " or more" : "", max_depth));
+  };
+  const auto newline = [&] {
+    ++line;
+    line_start = i + 1;
+  };
+  const auto skip_blanks = [&] {
+    while (i < n && (text[i] == ' ' || text[i] == '\t' || text[i] == '\r')) ++i;
+  };
+  // Blanks, newlines and comments: between the values of an array.
+  const auto skip_space = [&] {
+    for (;;) {
+      skip_blanks();
+      if (at(i) == '#')
+        while (i < n && text[i] != '\n') ++i;
+      if (at(i) != '\n') return;
+      newline();
+      ++i;
+    }
+  };
+  const auto skip_string = [&] {
+    const char quote = text[i];
+    const bool multi = at(i + 1) == quote && at(i + 2) == quote;
+    i += multi ? 3 : 1;
+    while (i < n) {
+      const char c = text[i];
+      if (c == '\\' && quote == '"') {
+        i += at(i + 1) == '\n' ? 1 : 2;  // a line-ending backslash: the newline is counted next
+        continue;
+      }
+      if (c == '\n') {
+        newline();
+        if (!multi) return;  // unterminated: toml++ says so
+      }
+      if (c == quote && (!multi || (at(i + 1) == quote && at(i + 2) == quote))) {
+        i += multi ? 3 : 1;
+        while (multi && at(i) == quote) ++i;  // up to two quotes of the content before the closing three
+        return;
+      }
+      ++i;
+    }
+  };
+  const auto bare = [](char c) {
+    return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
+  };
+  // A dotted key's parts (0: none there); key_end is where its last one ends.
+  std::size_t key_end = 0;
+  const auto key_parts = [&] {
+    int parts = 0;
+    for (;;) {
+      skip_blanks();
+      if (at(i) == '"' || at(i) == '\'') {
+        skip_string();
+      } else if (bare(at(i))) {
+        while (bare(at(i))) ++i;
+      } else {
+        return parts;
+      }
+      ++parts;
+      key_end = i;
+      skip_blanks();
+      if (at(i) != '.') return parts;
+      ++i;
+    }
+  };
+  const auto skip_scalar = [&] {
+    const std::size_t start = i;
+    while (i < n && std::string_view(",]}#\n \t\r").find(text[i]) == std::string_view::npos) ++i;
+    if (i == start) ++i;
+  };
+
+  struct Open {
+    char close;  // ']' an array, '}' an inline table
+    int depth;   // of its values (an inline table's: before its keys' parts)
+  };
+  std::vector<Open> open;
+  if (text.starts_with("\xEF\xBB\xBF")) i = 3;
+  int table_depth = 0;  // of the last [header]
+  while (i < n) {
+    // A statement: a [header], [[header]], or key = value.
+    skip_space();
+    if (i >= n) break;
+    const std::size_t start = i;
+    if (text[i] == '[') {
+      i += at(i + 1) == '[' ? 2 : 1;
+      const std::size_t key_start = i;
+      table_depth = key_parts();
+      if (table_depth > max_depth) refuse(start, key_start, key_end, table_depth);
+      while (i < n && text[i] != '\n' && text[i] != '#') ++i;
+      continue;
+    }
+    const int parts = key_parts();
+    const std::size_t statement_key_end = key_end;
+    if (parts == 0 || at(i) != '=') {
+      while (i < n && text[i] != '\n') ++i;  // not a statement: toml++ says what it is
+      continue;
+    }
+    if (table_depth + parts > max_depth) refuse(start, start, statement_key_end, table_depth + parts);
+    ++i;
+    // The value, and the values and keys inside it.
+    enum class Next { value, comma_or_close, key };
+    Next next = Next::value;
+    int depth = table_depth + parts;
+    open.clear();
+    for (;;) {
+      if (open.empty())
+        skip_blanks();  // a value ends with its line
+      else
+        skip_space();
+      if (i >= n) break;
+      const char c = text[i];
+      if (next == Next::value) {
+        next = Next::comma_or_close;
+        if (c == '[' || c == '{') {
+          if (c == '[') ++depth;
+          if (depth > max_depth) refuse(i, start, statement_key_end, depth, true);
+          open.push_back({c == '[' ? ']' : '}', depth});
+          ++i;
+          next = c == '[' ? Next::value : Next::key;
+        } else if (c == '"' || c == '\'') {
+          skip_string();
+        } else if (c != ']' && c != '}') {  // those close an empty array, or one after a trailing comma
+          skip_scalar();
+        }
+      } else if (next == Next::comma_or_close) {
+        if (open.empty()) break;  // the statement's end
+        if (c == ',') {
+          ++i;
+          depth = open.back().depth;
+          next = open.back().close == ']' ? Next::value : Next::key;
+        } else if (c == ']' || c == '}') {
+          ++i;
+          open.pop_back();
+        } else {
+          skip_scalar();  // the time of a date-time, or what toml++ will refuse
+        }
+      } else if (c == '}') {  // an empty inline table
+        ++i;
+        open.pop_back();
+        next = Next::comma_or_close;
+      } else {
+        const std::size_t key_start = i;
+        const int inner = key_parts();
+        skip_blanks();
+        if (at(i) == '=')
+          ++i;
+        else if (i == key_start)
+          skip_scalar();  // not a key: past it, whatever it is
+        depth = open.back().depth + std::max(inner, 1);
+        if (depth > max_depth) refuse(key_start, start, statement_key_end, depth, true);
+        next = Next::value;
+      }
+    }
+  }
+}
+
 // Insert `value` (TOML syntax) at a dotted path, creating tables on the way.
 void apply_override(toml::table& root, const std::string& assignment) {
   const auto eq = assignment.find('=');
@@ -134,9 +315,15 @@ void apply_override(toml::table& root, const std::string& assignment) {
                             "--set seepage.time_step='\"1 h\"'",
                             assignment));
   const std::string path = assignment.substr(0, eq);
+  if (const auto parts = std::count(path.begin(), path.end(), '.') + 1; parts > max_depth)
+    throw Error(fmt::format("--set: key '{}...': nested {} levels deep (each part of a dotted key is a level); a "
+                            "scene may nest at most {}",
+                            path.substr(0, 60), parts, max_depth));
   toml::table parsed;
+  const std::string value = "v = " + assignment.substr(eq + 1);
+  check_depth(value, "--set", path);
   try {
-    parsed = toml::parse("v = " + assignment.substr(eq + 1), std::string_view("--set"));
+    parsed = toml::parse(value, std::string_view("--set"));
   } catch (const toml::parse_error& e) {
     throw Error(fmt::format("--set '{}': the value is not TOML ({}); strings need quotes, "
                             "for example --set seepage.time_step='\"1 h\"'",
@@ -238,6 +425,7 @@ std::unique_ptr<Document> Document::parse(std::string_view text, const std::stri
   doc->file_ = name;
   doc->text_ = std::string(text);
   doc->overrides_ = overrides;
+  check_depth(doc->text_, name);
   try {
     doc->root_ = std::make_unique<toml::table>(toml::parse(doc->text_, name));
   } catch (const toml::parse_error& e) {

@@ -89,6 +89,8 @@ const std::array<NamedDimension, 20> named_dimensions{{
 // Recursive-descent parser over a unit expression:
 //   expr   := factor { ('*' | '.' | ' ' | '/') factor }
 //   factor := ( symbol | '(' expr ')' ) [ '^' number | digits ]
+// Each '(' is a level of recursion: parentheses nested deeper than any unit
+// needs are refused before they exhaust the stack (50,000 of them did).
 class UnitParser {
  public:
   explicit UnitParser(std::string_view text) : text_(text) {}
@@ -102,8 +104,10 @@ class UnitParser {
   }
 
  private:
+  static constexpr int max_depth = 32;
   std::string_view text_;
   std::size_t pos_ = 0;
+  int depth_ = 0;
 
   [[noreturn]] void fail(const std::string& what) const {
     throw UnitError(fmt::format("cannot read the unit \"{}\": {}", text_, what));
@@ -149,8 +153,11 @@ class UnitParser {
     skip_spaces();
     Quantity base;
     if (pos_ < text_.size() && text_[pos_] == '(') {
+      if (++depth_ > max_depth)
+        fail(fmt::format("parentheses nested deeper than {} levels (at character {})", max_depth, pos_ + 1));
       ++pos_;
       base = expression();
+      --depth_;
       skip_spaces();
       if (pos_ >= text_.size() || text_[pos_] != ')') fail("missing ')'");
       ++pos_;
@@ -269,6 +276,11 @@ Quantity parse_quantity(std::string_view text) {
     throw UnitError(fmt::format("the number in \"{}\" is beyond the range of numbers (about 1e-308 to 1e308)", text));
   if (ec != std::errc() || end == first)
     throw UnitError(fmt::format("\"{}\" does not start with a number", text));
+  // from_chars reads "nan" and "inf" too, which no unit makes finite.
+  if (std::isnan(value))
+    throw UnitError(fmt::format("\"{}\" starts with NaN, which is not a value; give a finite number", text));
+  if (std::isinf(value))
+    throw UnitError(fmt::format("\"{}\" starts with an infinite number; give a finite one", text));
   std::string_view rest(end, static_cast<std::size_t>(last - end));
   while (!rest.empty() && rest.front() == ' ') rest.remove_prefix(1);
   while (!rest.empty() && rest.back() == ' ') rest.remove_suffix(1);

@@ -204,11 +204,24 @@ void Coupling::load(const checkpoint::In& in) {
   const std::string names = in.text("slice_names");
   const auto extents = in.counts<std::int64_t>("slice_extents");
   slices_.clear();
+  // The fields first reads, in the scheme's order, each a slice of y after
+  // the one before: writing y to first reads them there.
+  std::int64_t covered = 0;
   for (std::size_t start = 0, end, k = 0; (end = names.find('\n', start)) != std::string::npos; start = end + 1, ++k) {
     if (2 * k + 1 >= extents.size()) in.fail("slice_extents", "fewer extents than slice names");
-    slices_.push_back({names.substr(start, end - start), static_cast<std::size_t>(extents[2 * k]),
-                       static_cast<std::size_t>(extents[2 * k + 1])});
+    const std::string name = names.substr(start, end - start);
+    if (k >= settings_.to_first.size() || name != settings_.to_first[k].field)
+      in.fail("slice_names", fmt::format("field '{}' where this scheme's fields are {}", name, settings_.to_first.size()));
+    const auto offset = extents[2 * k], size = extents[2 * k + 1];
+    if (offset != covered || size < 0 || size > y_.size() - offset)
+      in.fail("slice_extents", fmt::format("field '{}' at entries {} to {} of a y of {}, after the {} the fields before "
+                                           "take",
+                                           name, offset, offset + size, y_.size(), covered));
+    covered += size;
+    slices_.push_back({name, static_cast<std::size_t>(offset), static_cast<std::size_t>(size)});
   }
+  if (!slices_.empty() && covered != y_.size())
+    in.fail("slice_extents", fmt::format("the fields take {} entries of a y of {}", covered, y_.size()));
   const auto records = in.group("records");
   const auto start = records.numbers("start");
   const std::size_t n = start.size();

@@ -9,6 +9,7 @@
 
 #include "common/atomic_file.hpp"
 #include "common/limits.hpp"
+#include "common/manifest.hpp"
 #include "common/output_folder.hpp"
 #include "common/program.hpp"
 #include "common/progress.hpp"
@@ -30,6 +31,7 @@ class WindowLog {
   WindowLog(const std::filesystem::path& file, const std::vector<coupling::Convergence>& fields, bool resume)
       : path_(file), fields_(fields.size()) {
     if (resume) return;
+    output::record_written(file);
     out_.open(file);
     out_ << "window,time,size,iterations,converged,seepage_s,solid_s,coupler_s,open_cells,gas_released,"
             "kinetic_energy,particles";

@@ -15,18 +15,38 @@ namespace outburst::coupling {
 namespace {
 
 // The shortest edge of any cell: of a quadrilateral's four, or a hexahedron's
-// twelve (corners 0-3 one face, 4-7 the opposite one, in Gmsh's order).
+// twelve (corners 0-3 one face, 4-7 the opposite one, in Gmsh's order), and
+// the centre of its cell.
 template <int Dim>
-double narrowest_cell(const seepage::MeshOf<Dim>& mesh) {
+struct Narrowest {
+  double width = std::numeric_limits<double>::infinity();
+  Eigen::Matrix<double, Dim, 1> centre;
+};
+template <int Dim>
+Narrowest<Dim> narrowest_cell(const seepage::MeshOf<Dim>& mesh) {
   constexpr std::array<std::array<int, 2>, 12> edges{
       {{0, 1}, {1, 2}, {2, 3}, {3, 0}, {4, 5}, {5, 6}, {6, 7}, {7, 4}, {0, 4}, {1, 5}, {2, 6}, {3, 7}}};
-  double narrowest = std::numeric_limits<double>::infinity();
+  Narrowest<Dim> narrowest;
   for (std::size_t c = 0; c < mesh.num_cells(); ++c) {
     const auto x = mesh.corners(c);
     for (int k = 0; k < (Dim == 2 ? 4 : 12); ++k)
-      narrowest = std::min(narrowest, (x[edges[k][1]] - x[edges[k][0]]).norm());
+      if (const double width = (x[edges[k][1]] - x[edges[k][0]]).norm(); width < narrowest.width) {
+        narrowest.width = width;
+        narrowest.centre.setZero();
+        for (const auto& corner : x) narrowest.centre += corner / static_cast<double>(x.size());
+      }
   }
   return narrowest;
+}
+
+// How far round-off may have moved the mesh's nodes: single precision's
+// spacing at its largest coordinate, since meshers that store floats, or
+// print seven digits, place a node so far from where it was meant.
+template <int Dim>
+double coordinate_round_off(const seepage::MeshOf<Dim>& mesh) {
+  double largest = 0;
+  for (const auto& x : mesh.nodes) largest = std::max(largest, x.template lpNorm<Eigen::Infinity>());
+  return largest * 0x1p-23;
 }
 
 // The seepage mesh's bounding box.
@@ -56,7 +76,7 @@ std::vector<double> modulus_scale_range(const mpm::Particles<Dim>& p, int m) {
 
 template <int Dim>
 std::vector<stability::Regime> poroelastic_regimes(const CoupledSetup<Dim>& s) {
-  const double cell = narrowest_cell(s.seepage.mesh);
+  const double cell = narrowest_cell(s.seepage.mesh).width;
   const auto [lo, hi] = extent(s.seepage.mesh);
   std::vector<stability::Regime> regimes;
   const auto& p = s.solid.particles;
@@ -193,19 +213,27 @@ CoupledSetup<Dim> read_coupled_scene(scene::Table root) {
   // open space and misses the coal's volume change (measured: Mandel's
   // pressure grows without bound with particles 0.0625 m apart on 0.05 m
   // cells; the outburst's seam opened whole with particles 1/6 m apart on
-  // 0.25 m cells, one to a row in some: 44 % full).
+  // 0.25 m cells, one to a row in some: 44 % full). A cell narrower than a
+  // whole number of rows by no more than the nodes' round-off still holds
+  // them, but for a particle that close to its edge, whose cell round-off
+  // decides anyway.
   double spacing = 0;
   for (double w : s.solid.particles.half_width) spacing = std::max(spacing, 2 * w * s.solid.grid.h);
-  const double narrowest = narrowest_cell(s.seepage.mesh);
-  const double per_row = std::floor(narrowest / spacing * (1 + 1e-9));
-  const double least_fill = std::pow(per_row * spacing / narrowest, Dim);
-  if (per_row < 1 || least_fill < s.coupling.gas_solid.open_below)
+  const auto narrowest = narrowest_cell(s.seepage.mesh);
+  const double per_row = std::floor((narrowest.width + coordinate_round_off(s.seepage.mesh)) / spacing);
+  const double least_fill = std::pow(per_row * spacing / narrowest.width, Dim);
+  if (per_row < 1 || least_fill < s.coupling.gas_solid.open_below) {
+    std::vector<std::string> centre;
+    for (int d = 0; d < Dim; ++d) centre.push_back(fmt::format("{:.6g}", narrowest.centre[d]));
     root.table("mpm", "", true)->fail(
         "grid.cell_size",
-        fmt::format("particles {:.4g} m apart fill a seepage cell {:.4g} m wide to as little as {:.0f} % (cells "
-                    "below coupling.open_below = {:g} read as open space and miss the coal's volume change): "
-                    "refine the MPM (grid.cell_size, bodies' particles_per_cell) or coarsen the seepage mesh",
-                    spacing, narrowest, 100 * least_fill, s.coupling.gas_solid.open_below));
+        fmt::format("the narrowest seepage cell, {:.6g} m wide (at ({}) m), holds {} {} of particles {:.4g} m "
+                    "apart ({} rows need {:.6g} m): as little as {:.0f} % of it in particles, and cells below "
+                    "coupling.open_below = {:g} read as open space and miss the coal's volume change; refine the "
+                    "MPM (grid.cell_size, bodies' particles_per_cell) or coarsen the seepage mesh",
+                    narrowest.width, fmt::join(centre, ", "), per_row, per_row == 1 ? "row" : "rows", spacing, per_row + 1,
+                    (per_row + 1) * spacing, 100 * least_fill, s.coupling.gas_solid.open_below));
+  }
   mpm::check_time_step(*root.table("mpm", "", true), s.solid);
   return s;
 }

@@ -389,9 +389,11 @@ inline double drucker_prager_return(double alpha, double k, double alpha_dilatio
   double mean = inv.mean - bulk * alpha_dilation * dlambda;
   double sqrt_j2 = inv.sqrt_j2 - g * dlambda;
   if (sqrt_j2 < 0) {
-    // Past the apex (only a cone with alpha > 0 has one): the only admissible
-    // state is hydrostatic tension at the apex.
-    mean = k / alpha;
+    // Past the tip: the only admissible state is hydrostatic, at the apex of a
+    // cone (alpha > 0). A cylinder (alpha = 0, no friction) gets here only by
+    // round-off, when its radius k is 0 (no cohesion either: a fluid's
+    // strength): the deviator goes, the mean stress stays (k / alpha was 0 / 0).
+    if (alpha > 0) mean = k / alpha;
     sqrt_j2 = 0;
     dlambda = inv.sqrt_j2 / g;
   }

@@ -9,6 +9,8 @@
 #include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
+#include "common/manifest.hpp"
+
 namespace outburst::mpm {
 
 namespace {
@@ -51,10 +53,12 @@ Output<Dim>::Output(const std::filesystem::path& directory, const output::RunInf
   series_.add_point_grid("particles");
   if (resume) return;
   if (!tracers_.empty()) {
+    output::record_written(tracer_path());
     tracer_file_.open(tracer_path(), std::ios::trunc);
     tracer_file_ << "time_s,tracer,particle_id," << per_axis<Dim>("{}_m") << "," << per_axis<Dim>("v{}_m_per_s")
                  << ",speed_m_per_s," << per_axis<Dim>("u{}_m") << ",sigma_max_Pa,sigma_min_Pa,plastic_strain,damage\n";
   }
+  output::record_written(history_path());
   history_.open(history_path(), std::ios::trunc);
   const std::string unit = Dim == 2 ? "J_per_m" : "J";
   history_ << fmt::format("step,time_s,dt_s,particles,removed_total,kinetic_{0},strain_{0},gravity_{0},plastic_{0},"

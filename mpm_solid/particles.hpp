@@ -2,6 +2,7 @@
 // Material points as a structure of arrays: each field is one contiguous
 // vector, so the kernels stream through memory and no particle owns heap data.
 
+#include <algorithm>
 #include <cstdint>
 #include <string_view>
 #include <tuple>
@@ -168,6 +169,7 @@ struct Particles {
       else
         values.clear();
     });
+    check_restored(in);
     // An effect's fields come and go together (the kernels test one of them).
     for_each_field([&](const auto& field, const auto& values) {
       if (!field.optional()) return;
@@ -219,6 +221,31 @@ struct Particles {
   }
 
  private:
+  // Refuses restored values no run holds (the numbers are finite already,
+  // checkpoint::In): an id that is negative or given twice would stand for
+  // two particles in every later snapshot; a mass, volume or width of zero or
+  // less divides the step's transfers by it.
+  void check_restored(const checkpoint::In& in) const {
+    const auto refuse = [&](const char* name, std::size_t i, const std::string& what) {
+      in.fail(name, fmt::format("particle {} (row {}) {}, which no run holds: the checkpoint is damaged", id[i], i, what));
+    };
+    for (std::size_t i = 0; i < size(); ++i) {
+      if (id[i] < 0) refuse("id", i, "has a negative id");
+      if (!(mass[i] > 0)) refuse("mass", i, fmt::format("has the mass {}", mass[i]));
+      if (!(volume[i] > 0)) refuse("volume", i, fmt::format("has the volume {}", volume[i]));
+      if (!(volume0[i] > 0)) refuse("volume0", i, fmt::format("has the initial volume {}", volume0[i]));
+      if (!(half_width[i] > 0)) refuse("half_width", i, fmt::format("has the half-width {}", half_width[i]));
+    }
+    std::vector<std::size_t> by_id(size());
+    for (std::size_t i = 0; i < by_id.size(); ++i) by_id[i] = i;
+    std::sort(by_id.begin(), by_id.end(), [&](std::size_t a, std::size_t b) { return id[a] < id[b]; });
+    for (std::size_t k = 1; k < by_id.size(); ++k)
+      if (id[by_id[k]] == id[by_id[k - 1]])
+        refuse("id", std::max(by_id[k], by_id[k - 1]), fmt::format("has the id of row {} too", std::min(by_id[k], by_id[k - 1])));
+    for (std::size_t i = 0; i < damage.size(); ++i)
+      if (!(damage[i] >= 0 && damage[i] <= 1)) refuse("optional/damage", i, fmt::format("has the damage {}", damage[i]));
+  }
+
   template <class T>
   static T initial(const Field<T>& field) {
     if constexpr (std::is_arithmetic_v<T>)

@@ -11,6 +11,8 @@ packages=(
   libeigen3-dev libsuitesparse-dev libopenblas-dev
   # output, scene files, command line, logging, tests
   libhdf5-dev libtomlplusplus-dev libcli11-dev libspdlog-dev libfmt-dev catch2
+  # checkpoints' checksums (CRC-32)
+  zlib1g-dev
   # figures, and ParaView's Python for checking that our output opens
   python3 python3-matplotlib python3-numpy python3-h5py python3-paraview
   # scene files edited by the studies (comments kept); the outburst's finer

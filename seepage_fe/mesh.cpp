@@ -171,10 +171,10 @@ class MshReader {
     try {
       std::size_t used = 0;
       const double v = std::stod(token, &used);
-      if (used == token.size()) return v;
+      if (used == token.size() && std::isfinite(v)) return v;
     } catch (const std::exception&) {
     }
-    fail(fmt::format("expected {} (a number), got '{}'", what, token));
+    fail(fmt::format("expected {} (a finite number), got '{}'", what, token));
   }
 
   void expect_count(const std::vector<std::string>& t, std::size_t n, const char* what) const {
@@ -238,9 +238,14 @@ struct ElementBlock {
   std::vector<int> lines;
 };
 
+struct GmshNode {
+  Eigen::Vector3d x;  // [m]
+  int line;           // of its coordinates
+};
+
 struct GmshFile {
   std::map<std::pair<int, int>, std::string> physical_names;  // (dim, tag) -> name
-  std::unordered_map<long, Eigen::Vector3d> nodes;            // tag -> x y z [m]
+  std::unordered_map<long, GmshNode> nodes;                   // by tag
   std::vector<ElementBlock> blocks;
   bool has_hexahedra() const {
     return std::any_of(blocks.begin(), blocks.end(), [](const ElementBlock& b) { return b.dim == 3 && b.count > 0; });
@@ -314,8 +319,15 @@ GmshFile parse_gmsh(MshReader& r, double length_scale) {
         for (long i = 0; i < n; ++i) {
           const auto c = r.tokens("node coordinates 'x y z'");
           r.expect_count(c, 3, "node coordinates 'x y z'");
-          g.nodes[tags[i]] =
+          const Eigen::Vector3d x =
               Eigen::Vector3d(r.number(c[0], "x"), r.number(c[1], "y"), r.number(c[2], "z")) * length_scale;
+          // A tag given twice at one place names one node; at two, the cells
+          // would take whichever definition came last.
+          const auto [it, added] = g.nodes.try_emplace(tags[i], GmshNode{x, r.line()});
+          if (!added && it->second.x != x)
+            r.fail(fmt::format("node {} is defined a second time, elsewhere than at line {}: a node tag names one "
+                               "point (given twice, it must have the same coordinates)",
+                               tags[i], it->second.line));
         }
       }
       r.expect_end("$EndNodes");
@@ -380,30 +392,28 @@ void check_blocks(const GmshFile& g, const MshReader& r) {
   }
 }
 
-// A plane mesh's boundary lines, as they are listed.
-void add_boundaries(Mesh& mesh, const GmshFile& g, const std::unordered_map<long, int>& index,
-                    const std::filesystem::path& file) {
-  std::map<int, std::size_t> boundary_of_physical;
-  for (const auto& b : g.blocks) {
-    if (b.dim != 1 || b.tags.empty()) continue;
-    for (std::size_t e = 0; e < b.lines.size(); ++e) {
-      const long first = b.tags[2 * e], second = b.tags[2 * e + 1];
-      const auto a = index.find(first), c = index.find(second);
-      if (a == index.end() || c == index.end())
-        throw std::runtime_error(fmt::format("{}: a boundary line uses node {} or {}, which no quadrangle uses",
-                                             file.string(), first, second));
-      const auto [it, added] = boundary_of_physical.try_emplace(b.physical, mesh.boundaries.size());
-      if (added) mesh.boundaries.push_back({g.physical_name(1, b.physical), {}});
-      mesh.boundaries[it->second].faces.push_back({a->second, c->second});
-    }
-  }
+// A counter-clockwise quadrilateral's edges, each by its corners in the order
+// that faces out of the cell, as q1::hex_face does a hexahedron's faces.
+constexpr int quad_edge[4][2] = {{0, 1}, {1, 2}, {2, 3}, {3, 0}};
+
+template <int Dim>
+constexpr const auto& cell_faces() {
+  if constexpr (Dim == 2)
+    return quad_edge;
+  else
+    return q1::hex_face;
 }
 
-// A volume mesh's boundary quadrangles, each replaced by the face of the
-// hexahedron it lies on as that hexahedron sees it, facing out (a face inside
-// the mesh: out of the first hexahedron listed that holds it).
-void add_boundaries(Mesh3& mesh, const GmshFile& g, const std::unordered_map<long, int>& index,
+// A mesh's boundary elements (lines of a plane mesh, quadrangles of a volume
+// one), each replaced by the face of the cell it lies on as that cell sees it,
+// facing out (a face inside the mesh: out of the first cell listed that holds
+// it). An element on no cell's face is refused: its condition would apply
+// between nodes no face joins, inside the mesh.
+template <int Dim>
+void add_boundaries(MeshOf<Dim>& mesh, const GmshFile& g, const std::unordered_map<long, int>& index,
                     const std::filesystem::path& file) {
+  using Face = typename MeshOf<Dim>::Face;
+  constexpr int corners = MeshOf<Dim>::face_corners;
   // The cells around each node.
   std::vector<int> start(mesh.num_nodes() + 1, 0), around;
   for (const auto& cell : mesh.cells)
@@ -414,12 +424,13 @@ void add_boundaries(Mesh3& mesh, const GmshFile& g, const std::unordered_map<lon
   for (std::size_t c = 0; c < mesh.num_cells(); ++c)
     for (int node : mesh.cells[c]) around[filled[node]++] = static_cast<int>(c);
 
-  const auto outward_face = [&](std::array<int, 4> nodes) -> std::optional<Mesh3::Face> {
+  const auto outward_face = [&](Face nodes) -> std::optional<Face> {
     std::sort(nodes.begin(), nodes.end());
     for (int k = start[nodes[0]]; k < start[nodes[0] + 1]; ++k) {
       const auto& cell = mesh.cells[around[k]];
-      for (const auto& local : q1::hex_face) {
-        Mesh3::Face face{cell[local[0]], cell[local[1]], cell[local[2]], cell[local[3]]};
+      for (const auto& local : cell_faces<Dim>()) {
+        Face face;
+        for (int a = 0; a < corners; ++a) face[a] = cell[local[a]];
         auto sorted = face;
         std::sort(sorted.begin(), sorted.end());
         if (sorted == nodes) return face;
@@ -427,26 +438,30 @@ void add_boundaries(Mesh3& mesh, const GmshFile& g, const std::unordered_map<lon
     }
     return std::nullopt;
   };
+  const char* element = Dim == 2 ? "line" : "quadrangle";
+  const char* cell_word = Dim == 2 ? "quadrangle" : "hexahedron";
   std::map<int, std::size_t> boundary_of_physical;
   for (const auto& b : g.blocks) {
-    if (b.dim != 2 || b.tags.empty()) continue;
+    if (b.dim != Dim - 1 || b.tags.empty()) continue;
+    const std::string physical = g.physical_name(Dim - 1, b.physical);
     for (std::size_t e = 0; e < b.lines.size(); ++e) {
-      std::array<int, 4> nodes{};
-      for (int a = 0; a < 4; ++a) {
-        const long tag = b.tags[4 * e + a];
+      Face nodes{};
+      for (int a = 0; a < corners; ++a) {
+        const long tag = b.tags[corners * e + a];
         const auto found = index.find(tag);
         if (found == index.end())
-          throw std::runtime_error(fmt::format("{}:{}: this boundary quadrangle uses node {}, which no hexahedron uses",
-                                               file.string(), b.lines[e], tag));
+          throw std::runtime_error(fmt::format("{}:{}: this boundary {} uses node {}, which no {} uses", file.string(),
+                                               b.lines[e], element, tag, cell_word));
         nodes[a] = found->second;
       }
       const auto face = outward_face(nodes);
       if (!face)
-        throw std::runtime_error(fmt::format("{}:{}: this quadrangle of physical surface \"{}\" is not a face of any "
-                                             "hexahedron: a boundary must lie on the cells' faces",
-                                             file.string(), b.lines[e], g.physical_name(2, b.physical)));
+        throw std::runtime_error(fmt::format(
+            "{}:{}: this {} of physical {} \"{}\" is not {} of any {}: a boundary must lie on the cells' {}",
+            file.string(), b.lines[e], element, Dim == 2 ? "curve" : "surface", physical,
+            Dim == 2 ? "an edge" : "a face", cell_word, Dim == 2 ? "edges" : "faces"));
       const auto [it, added] = boundary_of_physical.try_emplace(b.physical, mesh.boundaries.size());
-      if (added) mesh.boundaries.push_back({g.physical_name(2, b.physical), {}});
+      if (added) mesh.boundaries.push_back({physical, {}});
       mesh.boundaries[it->second].faces.push_back(*face);
     }
   }
@@ -475,7 +490,7 @@ MeshOf<Dim> build_mesh(const GmshFile& g, const MshReader& r, const std::filesys
       throw std::runtime_error(
           fmt::format("{}:{}: the element uses node {}, which $Nodes does not define", file.string(), line, tag));
     const int i = static_cast<int>(mesh.nodes.size());
-    mesh.nodes.push_back(xyz->second.template head<Dim>());
+    mesh.nodes.push_back(xyz->second.x.template head<Dim>());
     index[tag] = i;
     return i;
   };

@@ -4,6 +4,8 @@
 
 #include <fmt/format.h>
 
+#include "common/manifest.hpp"
+
 namespace outburst::seepage {
 
 namespace {
@@ -32,6 +34,7 @@ Output::Output(const std::filesystem::path& directory, const output::RunInfo& in
 
   if (resume) return;
   const char* volume = Dim == 2 ? "m3_per_m" : "m3";
+  output::record_written(history_path_);
   history_.open(history_path_, std::ios::trunc);
   history_ << fmt::format("step,time_s,dt_s,substeps,cuts,iterations,stored_{},inflow_flux_{}", volume, volume);
   for (const auto& b : solver.balance().pressure_boundaries) history_ << ",inflow_" << b << "_" << volume;

@@ -742,6 +742,14 @@ void SolverOf<Dim>::load(const checkpoint::In& in) {
     if (by < -1 || by > conditions) in.fail("fixed_by", fmt::format("a node fixed by condition {} of {}", by, conditions));
   for (const int slot : s.pressure_bc_slot)
     if (slot < -1 || slot >= static_cast<int>(slots)) in.fail("pressure_bc_slot", fmt::format("slot {} of {}", slot, slots));
+  // Values no run holds (the numbers are finite already): the assembly
+  // needs each cell's conductivity positive, as set_conductivity does.
+  if (s.steps < 0) in.fail("steps", fmt::format("{} steps", s.steps));
+  for (std::size_t c = 0; c < s.conductivity.size(); ++c)
+    if (!(s.conductivity[c] > 0))
+      in.fail("conductivity", fmt::format("cell {} has the conductivity {}, which no run holds: the checkpoint is "
+                                          "damaged",
+                                          c, s.conductivity[c]));
   restore_state(s);
 }
 

@@ -43,6 +43,16 @@ def main():
     if leftovers(work):
         failures.append(f"temporary files left: {leftovers(work)}")
     failures += unreadable(work, seepage_files + particle_files)
+    # A disk full before the run writes anything: a failed run too, exit code
+    # 1 (before: 2, as for a bad command line).
+    full = os.path.join(work, "full_at_start")
+    done = subprocess.run([program, scene, "-q", "-o", full], capture_output=True, text=True,
+                          preexec_fn=lambda: (signal.signal(signal.SIGXFSZ, signal.SIG_IGN),
+                                              resource.setrlimit(resource.RLIMIT_FSIZE, (0, resource.RLIM_INFINITY))))
+    message = done.stderr.strip().splitlines()[-1] if done.stderr.strip() else ""
+    print(f"full at the start: exit code {done.returncode}: {message}")
+    if done.returncode != 1 or "File too large" not in message:
+        failures.append(f"a disk full at the start: exit code {done.returncode}, expected 1 naming the full disk")
     if failures:
         sys.exit("; ".join(failures))
 

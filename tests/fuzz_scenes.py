@@ -6,11 +6,22 @@ Each mutant is checked (--check); some of those that pass also run briefly
 (end_time shortened), and a run still going at the time limit is sent SIGTERM
 and must stop (exit code 3) within 10 s.
 
+Then three shapes of their own (issue 57): deep nesting (a unit's
+parentheses, a dotted key, a [header], arrays, inline tables or a --set key,
+31 to 300,000 levels deep), corrupted meshes (a Gmsh file with a digit, a
+token or a line changed, a line gone or doubled, the file cut short; checked
+with --check), and corrupted checkpoints (bits flipped anywhere in a
+checkpoint taken mid-run by SIGTERM; continued with --restart, which must
+refuse it, exit code 2, or end with the results of the run never stopped, bit
+for bit).
+
 Pass: no death by a signal, no raw C++ exception text, exit codes 0, 1 (with
 a message of ours), 2 (bad input) or 3 (stopped on request), no hang (a check
-past the time limit, or a run that does not stop on SIGTERM).
+past the time limit, or a run that does not stop on SIGTERM); a damaged
+checkpoint refused or continued exactly.
 
-usage: fuzz_scenes.py BUILD_DIR SOURCE_DIR WORK_DIR [--seed 1] [--count 300] [--runs 20] [--limit 10]"""
+usage: fuzz_scenes.py BUILD_DIR SOURCE_DIR WORK_DIR [--seed 1] [--count 300] [--runs 20] [--limit 10]
+                      [--nesting 30] [--meshes 40] [--checkpoints 16]"""
 import argparse
 import collections
 import copy
@@ -140,12 +151,70 @@ def mutate(doc, rng):
     return f"{kind} {name}"
 
 
+# ---------------------------------------------------------------- deep nesting
+
+def nested(text, rng):
+    """The scene text, and the --set overrides, with one structure nested
+    deep; and what it did."""
+    depth = rng.choice([31, 32, 33, 100, 5000, 50000, 300000])
+    kind = rng.choice(["unit", "key", "header", "arrays", "tables", "set key"])
+    key = ".".join(["a"] * depth)
+    if kind == "unit":
+        quantities = list(re.finditer(r'"([-+0-9.eE]+) ([A-Za-z][^"]*)"', text))
+        if quantities:
+            m = rng.choice(quantities)
+            return (text[:m.start()] + f'"{m.group(1)} {"(" * depth}{m.group(2)}{")" * depth}"' + text[m.end():], [],
+                    f"a unit in {depth} parentheses")
+        kind = "key"
+    if kind == "set key":
+        depth = min(depth, 50000)  # an argument may hold 128 kB
+        return text, [".".join(["a"] * depth) + "=1"], f"a --set key of {depth} parts"
+    added = {"key": f"{key} = 1\n", "header": f"[{key}]\nb = 1\n", "arrays": "x = " + "[" * depth + "]" * depth + "\n",
+             "tables": "x = " + "{a = " * depth + "1" + " }" * depth + "\n"}[kind]
+    # Before the first table, where a key or array is the top level's.
+    first = text.find("\n[")
+    at = first + 1 if first >= 0 else len(text)
+    if kind == "header":
+        at = len(text)
+    return text[:at] + added + text[at:], [], f"{kind} {depth} deep"
+
+
+# ---------------------------------------------------------------- corrupted meshes
+
+def corrupted(lines, rng):
+    """A Gmsh file's lines with one change; and what it was."""
+    lines = list(lines)
+    k = rng.randrange(len(lines))
+    kind = rng.choice(["digit", "token", "delete", "double", "swap", "cut"])
+    if kind == "digit" and any(c.isdigit() for c in lines[k]):
+        at = rng.choice([i for i, c in enumerate(lines[k]) if c.isdigit()])
+        lines[k] = lines[k][:at] + rng.choice("0123456789") + lines[k][at + 1:]
+    elif kind == "token" and lines[k].split():
+        tokens = lines[k].split()
+        tokens[rng.randrange(len(tokens))] = rng.choice(["-1", "0", "2147483648", "9223372036854775808", "1e308",
+                                                         "nan", "inf", "x", "1.5", "$Nodes", '"a"'])
+        lines[k] = " ".join(tokens)
+    elif kind == "delete":
+        del lines[k]
+    elif kind == "double":
+        lines.insert(k, lines[k])
+    elif kind == "swap" and len(lines[k].split()) > 1:
+        tokens = lines[k].split()
+        i, j = rng.sample(range(len(tokens)), 2)
+        tokens[i], tokens[j] = tokens[j], tokens[i]
+        lines[k] = " ".join(tokens)
+    else:
+        lines = lines[:k]
+        kind = "cut"
+    return lines, f"{kind} at line {k + 1}"
+
+
 # ---------------------------------------------------------------- running
 
 def run(command, limit, stop_at_limit):
     """(exit code, output, outcome): outcome is "done", "stopped" (SIGTERM at
     the limit, then exit code 3) or "hang"."""
-    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, errors="replace",
                                env=dict(os.environ, OMP_NUM_THREADS="1"))
     try:
         output, _ = process.communicate(timeout=limit)
@@ -177,6 +246,72 @@ def judge(code, output, outcome, expect_stop):
     return problems
 
 
+# ---------------------------------------------------------------- corrupted checkpoints
+
+# (program, scene, overrides) of runs stopped by SIGTERM after their first
+# checkpoint, whose checkpoint is then damaged and continued.
+CHECKPOINTED = [
+    ("mpm_solid/mpm-solid", "granular_collapse/granular_collapse.toml",
+     ['scene.end_time="0.2 s"', 'output.interval="0.05 s"', 'output.checkpoint_interval="0.01 s"']),
+    ("seepage_fe/seepage-fe", "drainage/drainage.toml",
+     ['seepage.max_time_step="30 min"', 'output.checkpoint_interval="1 d"']),
+    ("coupler/outburst", "gas_face/gas_face.toml",
+     ['output.checkpoint_interval="1 ms"']),
+]
+
+
+def checkpointed(build, source, work, case, limit):
+    """(command, the run never stopped, a pristine copy of a run stopped
+    mid-way by SIGTERM), or a reason it could not be made."""
+    program, scene, overrides = case
+    name = os.path.basename(os.path.dirname(scene))
+
+    def line(out):
+        command = [os.path.join(build, program), os.path.join(source, "cases", scene), "-q", "-o", out, "-j", "1"]
+        for o in overrides:
+            command += ["--set", o]
+        return command
+    whole, stopped = os.path.join(work, f"{name}_whole"), os.path.join(work, f"{name}_stopped")
+    code, output, _ = run(line(whole), 4 * limit, False)
+    if code != 0:
+        return f"{name}: the run to compare with ended with exit code {code}: {output.strip()[-200:]}"
+    for _ in range(4):
+        shutil.rmtree(stopped, ignore_errors=True)
+        process = subprocess.Popen(line(stopped), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                                   env=dict(os.environ, OMP_NUM_THREADS="1"))
+        while process.poll() is None and not os.path.exists(os.path.join(stopped, "checkpoint.h5")):
+            time.sleep(0.002)
+        process.send_signal(signal.SIGTERM)
+        if process.wait(timeout=60) == 3:
+            return line, whole, stopped
+    return f"{name}: the run ended before SIGTERM four times"
+
+
+def flip_bits(path, rng):
+    """Flips 1 to 3 bits at random bytes of the file; returns where."""
+    with open(path, "r+b") as f:
+        size = os.path.getsize(path)
+        where = sorted(rng.randrange(size) for _ in range(rng.choice([1, 1, 2, 3])))
+        for at in where:
+            f.seek(at)
+            byte = f.read(1)[0]
+            f.seek(at)
+            f.write(bytes([byte ^ (1 << rng.randrange(8))]))
+    return where
+
+
+def same_results(reference, other):
+    """Differences between two run folders: the snapshots each index lists
+    and the last checkpoint (run_folder.py)."""
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    from run_folder import compare_checkpoints, compare_listed  # noqa: E402
+    found = []
+    for index in ("seepage.xdmf", "particles.xdmf"):
+        if os.path.exists(os.path.join(reference, index)):
+            found += compare_listed(reference, other, index)
+    return found + compare_checkpoints(reference, other)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("build")
@@ -186,6 +321,9 @@ def main():
     ap.add_argument("--count", type=int, default=300, help="mutants checked")
     ap.add_argument("--runs", type=int, default=20, help="of those passing --check, how many also run")
     ap.add_argument("--limit", type=float, default=10, help="seconds a check or a run may take")
+    ap.add_argument("--nesting", type=int, default=30, help="scenes nested deep, checked")
+    ap.add_argument("--meshes", type=int, default=40, help="corrupted meshes, checked")
+    ap.add_argument("--checkpoints", type=int, default=16, help="corrupted checkpoints, continued")
     args = ap.parse_args()
     rng = random.Random(args.seed)
 
@@ -239,10 +377,88 @@ def main():
             failures.append(f"{mutant} ({case}: {'; '.join(did)}): {', '.join(problems)}\n    " + "\n    ".join(last))
         else:
             os.remove(mutant)
+
+    # Deep nesting, in any scene.
+    for i in range(args.nesting):
+        scene = rng.choice(scenes)
+        with open(scene) as f:
+            text, overrides, did = nested(f.read(), rng)
+        mutant = os.path.join(copies[scene], f"nested_{i:05d}.toml")
+        with open(mutant, "w") as f:
+            f.write(text)
+        with open(scene, "rb") as f:
+            solvers = tuple(sorted(tomllib.load(f)["scene"]["solvers"]))
+        command = [os.path.join(args.build, PROGRAMS[solvers]), mutant, "--check", "-q"]
+        for o in overrides:
+            command += ["--set", o]
+        code, output, outcome = run(command, args.limit, False)
+        counts[f"nesting exit {code if outcome == 'done' else outcome}"] += 1
+        problems = judge(code, output, outcome, False)
+        if problems:
+            failures.append(f"{mutant} ({did}): {', '.join(problems)}")
+        else:
+            os.remove(mutant)
+
+    # Corrupted meshes, of the scenes that read one.
+    meshed = [s for s in scenes if re.search(r'^file = "([^"]+\.msh)"', open(s).read(), re.M)]
+    for i in range(args.meshes if meshed else 0):
+        scene = rng.choice(meshed)
+        with open(scene) as f:
+            text = f.read()
+        mesh = re.search(r'^file = "([^"]+\.msh)"', text, re.M).group(1)
+        with open(os.path.join(copies[scene], mesh)) as f:
+            lines, did = corrupted(f.read().split("\n"), rng)
+        name = f"mesh_{i:05d}"
+        with open(os.path.join(copies[scene], name + ".msh"), "w") as f:
+            f.write("\n".join(lines))
+        mutant = os.path.join(copies[scene], name + ".toml")
+        with open(mutant, "w") as f:
+            f.write(text.replace(f'file = "{mesh}"', f'file = "{name}.msh"'))
+        with open(scene, "rb") as f:
+            solvers = tuple(sorted(tomllib.load(f)["scene"]["solvers"]))
+        code, output, outcome = run([os.path.join(args.build, PROGRAMS[solvers]), mutant, "--check", "-q"],
+                                    args.limit, False)
+        counts[f"mesh exit {code if outcome == 'done' else outcome}"] += 1
+        problems = judge(code, output, outcome, False)
+        if problems:
+            failures.append(f"{mutant} ({os.path.basename(mesh)}: {did}): {', '.join(problems)}")
+        else:
+            os.remove(mutant)
+            os.remove(os.path.join(copies[scene], name + ".msh"))
+
+    # Corrupted checkpoints: refused, or continued to the results of the run
+    # never stopped.
+    made = []
+    for case in CHECKPOINTED if args.checkpoints else []:
+        got = checkpointed(args.build, args.source, os.path.join(args.work, "checkpoints"), case, args.limit)
+        if isinstance(got, str):
+            failures.append(got)
+        else:
+            made.append(got)
+    for i in range(args.checkpoints if made else 0):
+        line, whole, stopped = rng.choice(made)
+        out = f"{stopped}_{i:05d}"
+        shutil.copytree(stopped, out)
+        where = flip_bits(os.path.join(out, "checkpoint.h5"), rng)
+        code, output, outcome = run(line(out) + ["--restart"], 4 * args.limit, False)
+        counts[f"checkpoint exit {code if outcome == 'done' else outcome}"] += 1
+        problems = judge(code, output, outcome, False)
+        if not problems and code == 1:
+            problems.append("exit code 1: a damaged checkpoint must be refused (exit code 2) or continue exactly")
+        if not problems and code == 0:
+            problems += [f"restarted to other results: {d}" for d in same_results(whole, out)[:3]]
+        if problems:
+            last = [x for x in output.strip().splitlines() if x.strip()][-2:]
+            failures.append(f"{out} (bits flipped at bytes {where}): {', '.join(problems)}\n    " + "\n    ".join(last))
+        else:
+            shutil.rmtree(out)
+
     wall = time.monotonic() - start
     signals = sum(1 for f in failures if "killed by signal" in f)
     hangs = sum(1 for f in failures if "hang" in f)
-    print(f"fuzz: seed {args.seed}, {args.count} mutants of {len(scenes)} scenes checked, {ran} run, {wall:.0f} s")
+    print(f"fuzz: seed {args.seed}, {args.count} mutants of {len(scenes)} scenes checked, {ran} run, "
+          f"{args.nesting} nested deep, {args.meshes} meshes corrupted, {args.checkpoints} checkpoints damaged, "
+          f"{wall:.0f} s")
     for outcome, n in sorted(counts.items()):
         print(f"  {outcome}: {n}")
     print(f"  signal deaths: {signals}; hangs: {hangs}; other failures: {len(failures) - signals - hangs}")

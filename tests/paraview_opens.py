@@ -5,11 +5,17 @@ reads in its own order (a positive Jacobian at every corner: a mirrored or
 scrambled order gives a negative or twisted one) and the cells must fill
 VOLUME [m3].
 
-usage: pvpython paraview_opens.py PROGRAM SCENE WORKDIR XDMF_NAME FIELDS [--hexahedra VOLUME] [--set ...]...
+With --odd-path the scene runs from a copy in a folder whose name holds the
+bytes 0xff and 0x01, which the index must not carry raw (before: not XML,
+and ParaView read no points).
+
+usage: pvpython paraview_opens.py PROGRAM SCENE WORKDIR XDMF_NAME FIELDS [--hexahedra VOLUME] [--odd-path]
+                                  [--set ...]...
 FIELDS is a comma-separated list of the point and cell arrays expected.
 """
 import math
 import os
+import shutil
 import subprocess
 import sys
 
@@ -23,8 +29,16 @@ volume = None
 if rest[:1] == ["--hexahedra"]:
     volume = float(rest[1])
     rest = rest[2:]
+if rest[:1] == ["--odd-path"]:
+    rest = rest[1:]
+    odd = os.path.join(os.fsencode(os.path.abspath(workdir)), b"sc\xff\x01ene")
+    shutil.rmtree(odd, ignore_errors=True)
+    os.makedirs(odd)
+    shutil.copy(os.fsencode(scene), odd)
+    scene = os.path.join(odd, os.fsencode(os.path.basename(scene)))
 out = os.path.abspath(os.path.join(workdir, "out"))
-subprocess.run([program, scene, "--quiet", "-o", out, "--overwrite"] + rest, check=True)
+shutil.rmtree(out, ignore_errors=True)
+subprocess.run([program, scene, "--quiet", "-o", out] + rest, check=True)
 reader = XDMFReader(FileNames=[os.path.join(out, xdmf_name)])
 reader.UpdatePipelineInformation()
 times = list(reader.TimestepValues)

@@ -20,6 +20,7 @@ import subprocess
 import sys
 import threading
 import time
+import zlib
 from collections import namedtuple
 
 import h5py
@@ -228,6 +229,9 @@ def one_ulp_off(build, source, work, case, reference):
         position = x[middle]
         position[0] = np.nextafter(position[0], np.inf)
         x[middle] = position
+        # An edit, not damage: its checksum follows (a damaged checkpoint is
+        # refused, tests/damaged_checkpoint.py).
+        x.attrs["crc32"] = np.int64(zlib.crc32(x[...].astype("<f8").tobytes()))
     code, stderr, _, _ = run(line + ["--restart"])
     if code != 0:
         return [f"one ulp off: --restart: exit code {code}: {stderr.strip()[-200:]}"]

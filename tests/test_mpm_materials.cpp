@@ -107,6 +107,35 @@ TEST_CASE("Drucker-Prager tension returns to the apex: hydrostatic k / alpha", "
   CHECK(std::abs(p.stress[0](0, 1)) < 1e-9 * apex);
 }
 
+TEST_CASE("Drucker-Prager without friction or cohesion carries no shear: a fluid's mean stress alone",
+          "[mpm][material]") {
+  // alpha = k = 0: a cylinder of radius 0, whose return leaves sqrt(J2) at 0
+  // give or take round-off. Before: a return that round-off took below 0 went
+  // to the apex of a cone this has none of, k / alpha = 0 / 0, and the run
+  // died at its second step with a non-finite stress.
+  const Elasticity sand{1800, 10e6, 0.3};
+  const double g = sand.shear_modulus(), bulk = sand.lame_lambda() + 2.0 / 3.0 * g;
+  int returned = 0;
+  for (const double shear : {1e3, 2e3, 12345.0, 1e5, 3e5, 7.7e6}) {
+    for (const double mean : {-2e4, 0.0, 5e3}) {
+      INFO("shear " << shear << " Pa, mean " << mean << " Pa");
+      Mat<2> s;
+      s << mean + 0.1 * shear, shear, shear, mean - 0.1 * shear;
+      double s_zz = mean, work = -1;
+      drucker_prager_return<2>(0.0, 0.0, 0.0, g, bulk, s, s_zz, &work);
+      REQUIRE(s.allFinite());
+      REQUIRE(std::isfinite(s_zz));
+      CHECK(std::abs(s(0, 1)) <= 1e-12 * shear);
+      CHECK(s(0, 0) == Approx(mean).margin(1e-12 * shear));
+      CHECK(s(1, 1) == Approx(mean).margin(1e-12 * shear));
+      CHECK(s_zz == Approx(mean).margin(1e-12 * shear));
+      CHECK(work >= 0);
+      ++returned;
+    }
+  }
+  CHECK(returned == 18);
+}
+
 TEST_CASE("Drucker-Prager below the yield surface is elastic", "[mpm][material]") {
   DruckerPrager<2> plastic("coal", coal, 1e6, 30 * deg, 0.0, DruckerPragerFit::Kind::outer);
   LinearElastic<2> elastic("coal", coal);

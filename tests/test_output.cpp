@@ -3,6 +3,7 @@
 
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <csignal>
 #include <filesystem>
 #include <fstream>
@@ -75,6 +76,23 @@ TEST_CASE("a series writes mesh, snapshots and an index listing only complete sn
   CHECK(r.string_attribute("/", "version") == "0.0");
   CHECK(r.string_attribute("/mesh/p", "unit") == "Pa");
   CHECK(r.number_attribute("/", "time") == 1.0);
+}
+
+TEST_CASE("a scene path with bytes XML cannot hold is percent-encoded in the index", "[output]") {
+  const auto dir = fresh_dir("odd_path");
+  // Before: written raw, the index was not XML and ParaView read no points.
+  const std::string path = "/data/sc\xff\x01" "ene/100%/\xe7\x85\xa4 \xed\xa0\x80 \"a\"&<b>.toml";
+  output::RunInfo info{"test", "0.0", path, "", {}, "SI"};
+  output::FieldSeries series(dir, "run", info);
+  series.add_point_grid("particles");
+  output::Snapshot snap(0);
+  snap.set_points("particles", {0.5, 0.5, 0});
+  series.write(snap);
+  const std::string xdmf = read(series.index_path());
+  // Control characters, bytes that are not UTF-8 (0xff, a surrogate's
+  // encoding) and '%' encoded; a character (U+7164) and markup as XML has them.
+  CHECK_THAT(xdmf, Catch::Contains("Value=\"/data/sc%FF%01ene/100%25/\xe7\x85\xa4 %ED%A0%80 &quot;a&quot;&amp;&lt;b&gt;.toml\""));
+  CHECK(std::all_of(xdmf.begin(), xdmf.end(), [](char c) { return static_cast<unsigned char>(c) >= 0x20 || c == '\n'; }));
 }
 
 TEST_CASE("a hexahedral mesh is written with its 8 corners per cell and indexed as hexahedra", "[output]") {

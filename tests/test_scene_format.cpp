@@ -141,6 +141,54 @@ TEST_CASE("command-line overrides replace scene keys and are checked like them",
                     Catch::Contains("the scene has no table regions[18446744073709551617]"));
 }
 
+TEST_CASE("a scene nested deeper than 32 levels is refused where it goes deep, before it is parsed", "[scene]") {
+  // Before: a key or header of 35,000 parts (70 kB) overflowed the stack, in
+  // this reader's recursion or, at 300,000, in toml++'s.
+  const auto parts = [](int n, const std::string& name = "a") {
+    std::string key = name;
+    for (int i = 1; i < n; ++i) key += "." + name;
+    return key;
+  };
+  const auto parse = [](const std::string& text) { scene::Document::parse(text, "deep.toml"); };
+  const std::string start = "[scene]\ntitle = \"x\"\n";
+  CHECK_THROWS_WITH(parse(start + parts(35000) + " = 1\n"),
+                    Catch::Contains("deep.toml:3:1: key 'a.a.a.a.a") && Catch::Contains("a.a....':") &&
+                        Catch::Contains("nested 35001 levels deep") && Catch::Contains("at most 32"));
+  CHECK_THROWS_WITH(parse(start + "[" + parts(35000) + "]\nb = 1\n"),
+                    Catch::Contains("deep.toml:3:1") && Catch::Contains("nested 35000 levels deep"));
+  CHECK_THROWS_WITH(parse(start + "x = " + std::string(200000, '[') + std::string(200000, ']') + "\n"),
+                    Catch::Contains("deep.toml:3:35: key 'x': nested 33 or more levels deep"));
+  std::string inline_tables = "x = ";
+  for (int i = 0; i < 100000; ++i) inline_tables += "{a = ";
+  CHECK_THROWS_WITH(parse(start + inline_tables + "\n"),
+                    Catch::Contains("deep.toml:3:156: key 'x': nested 33 or more levels deep"));
+  CHECK_THROWS_WITH(scene::Document::parse(start, "deep.toml", {parts(35000) + "=1"}),
+                    Catch::Contains("--set: key 'a.a.a") && Catch::Contains("nested 35000 levels deep"));
+  CHECK_THROWS_WITH(scene::Document::parse(start, "deep.toml", {"scene.title=" + std::string(100000, '[')}),
+                    Catch::Contains("--set: key 'scene.title': nested 33 or more levels deep"));
+  // Each table, part of a key, array and inline table is a level: 32 pass.
+  CHECK_NOTHROW(parse(parts(32) + " = 1\n"));
+  CHECK_THROWS_WITH(parse(parts(33) + " = 1\n"), Catch::Contains("nested 33 levels deep"));
+  CHECK_NOTHROW(parse("[[x.y]]\n" + parts(30) + " = 1\n"));
+  CHECK_THROWS_WITH(parse("[[x.y]]\n" + parts(31) + " = 1\n"), Catch::Contains("deep.toml:2:1") &&
+                                                                  Catch::Contains("nested 33 levels deep"));
+  CHECK_NOTHROW(parse("x = " + std::string(31, '[') + std::string(31, ']') + "\n"));
+  CHECK_THROWS(parse("x = " + std::string(32, '[') + std::string(32, ']') + "\n"));
+  CHECK_NOTHROW(parse("x = " + std::string(27, '[') + "{a.b = [[1], {c = 2}]}" + std::string(27, ']') + "\n"));
+  CHECK_THROWS(parse("x = " + std::string(27, '[') + "{a.b = [[[1]], {c = 2}]}" + std::string(27, ']') + "\n"));
+  // What strings, quoted keys, comments and multi-line strings hold is not
+  // nesting, and dates and times are values like others.
+  CHECK_NOTHROW(parse(start + "\"" + parts(100) + "\" = 1\n'" + parts(100, "b") + "' = 2\n"));
+  CHECK_NOTHROW(parse(start + "s = \"" + std::string(100, '[') + " \\\" " + parts(100) + "\"  # " + parts(100) +
+                      " [[[[\n"));
+  CHECK_NOTHROW(parse(start + "m = \"\"\"\n" + parts(100) + " = [[[[[\n\\\n" + std::string(100, '{') + "\"\"\"\n" +
+                      "l = '''" + std::string(100, '[') + "'''\nd = [1979-05-27 07:32:00, 1979-05-27T00:32:00-07:00]\n" +
+                      "t = { a = { b = 1 }, c = [ { d = 2 }, [] ], e = {} }\n"));
+  // Lines are counted across multi-line strings.
+  CHECK_THROWS_WITH(parse(start + "m = \"\"\"\na\nb\\\nc\"\"\"\nn = '''\nx\n'''\n" + parts(40) + " = 1\n"),
+                    Catch::Contains("deep.toml:10:1"));
+}
+
 TEST_CASE("a scene that is not a regular file is refused before it is read", "[scene]") {
   // Before: /dev/zero was read without end.
   CHECK_THROWS_WITH(scene::Document::load("/dev/zero"), Catch::Contains("/dev/zero: the scene is a device"));

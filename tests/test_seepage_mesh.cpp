@@ -98,7 +98,7 @@ TEST_CASE("broken meshes are rejected with the line and what was expected", "[se
        header + entities + nodes + "$Elements\n1 1 1 1\n2 1 3 1\n1 1 2 3 9\n$EndElements\n",
        "uses node 9, which $Nodes does not define"},
       {"bad_number.msh", header + entities + "$Nodes\n1 4 1 4\n2 1 0 4\n1\n2\n3\n4\n0 0 0\n1 x 0\n",
-       ":20: expected y (a number), got 'x'"},
+       ":20: expected y (a finite number), got 'x'"},
       {"truncated.msh", header + entities + "$Nodes\n1 4 1 4\n2 1 0 4\n1\n2\n",
        "the file ends early"},
       {"not_msh.msh", "hello\n", "no $MeshFormat section"},

@@ -53,6 +53,11 @@ TEST_CASE("malformed quantities are rejected with the reason", "[units]") {
       {"1e400 Pa", "is beyond the range of numbers"},
       {"3 MPa^1e400", "1e400 is out of range"},
       {"3 MPa^400", "the power ^400 takes the unit beyond the range of numbers"},
+      // Named as what they are (before: "overflows").
+      {"NaN d", "\"NaN d\" starts with NaN, which is not a value"},
+      {"nan s", "starts with NaN"},
+      {"-inf Pa", "starts with an infinite number"},
+      {"infinity m", "starts with an infinite number"},
   };
   for (const auto& [text, message] : rows) {
     INFO(text);
@@ -64,4 +69,13 @@ TEST_CASE("dimensions are named in messages", "[units]") {
   CHECK(u::describe(u::pressure) == "pressure");
   CHECK(u::describe(u::time) == "time");
   CHECK(u::describe(Dimension{2, 0, -3, 0}) == "m^2 s^-3");
+}
+
+TEST_CASE("parentheses nested deeper than 32 levels are refused, however deep", "[units]") {
+  // Before: 50,000 of them overflowed the stack in the parser's recursion.
+  const auto nested = [](int n) { return "30 " + std::string(n, '(') + "d" + std::string(n, ')'); };
+  CHECK(parse_quantity(nested(32)).si == 30 * 86400.0);
+  CHECK_THROWS_WITH(parse_quantity(nested(33)), Catch::Contains("parentheses nested deeper than 32 levels"));
+  CHECK_THROWS_WITH(parse_quantity(nested(50000)), Catch::Contains("parentheses nested deeper than 32 levels"));
+  CHECK_THROWS_WITH(parse_quantity("3 " + std::string(1000000, '(')), Catch::Contains("nested deeper"));
 }

@@ -352,8 +352,9 @@ struct PlaneReturn {
   const double along = f / (g + bulk * alpha * 0.0);
   const double shrunk = sqrt_j2 - g * along;
   // A return that overshoots the cone's tip ends at the tip, as
-  // drucker_prager_return's does.
-  const double to_mean = shrunk < 0 ? cohesion / alpha : mean - bulk * 0.0 * along;
+  // drucker_prager_return's does (without friction, at the mean stress).
+  const double tip = alpha > 0 ? cohesion / alpha : mean;
+  const double to_mean = shrunk < 0 ? tip : mean - bulk * 0.0 * along;
   const double to_sqrt_j2 = shrunk < 0 ? 0.0 : shrunk;
   const double multiplier = shrunk < 0 ? sqrt_j2 / g : along;
   const double quotient = to_sqrt_j2 / sqrt_j2, ratio = sqrt_j2 > 0 ? quotient : 0.0;

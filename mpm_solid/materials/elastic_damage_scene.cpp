@@ -79,7 +79,7 @@ std::optional<DamageParameters::Heterogeneity> read_heterogeneity(const scene::T
                                                        "uniform the coal (1.5-5 is typical of RFPA models of coal "
                                                        "and rock)",
                                   "", Range::at_least(1)});
-  const std::string same_as_strength = fmt::format("{:.17g}", index);
+  const std::string same_as_strength = fmt::format("{}", index);  // shortest, and read back exactly
   return DamageParameters::Heterogeneity{
       index,
       static_cast<std::uint64_t>(h->integer<std::int64_t>(
