@@ -247,7 +247,7 @@ Reader::Reader(const std::filesystem::path& directory, const output::RunInfo& in
   const int threads = static_cast<int>(written_threads);
   if (threads != omp_get_max_threads())
     spdlog::warn("--restart: the checkpoint was written with {} threads, this run has {}: the run continues "
-                 "correctly, but not bit for bit as it would have with {} (README.md, Checkpoints and restart)",
+                 "correctly, but not bit for bit as it would have with {} (docs/user-guide/restart.md)",
                  threads, omp_get_max_threads(), threads);
 }
 

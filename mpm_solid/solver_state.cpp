@@ -36,7 +36,10 @@ void Solver<Dim>::load(const checkpoint::In& in) {
   fastest_ = 0;
   time_ = in.number("time");
   steps_ = in.count("steps");
-  removed_ = static_cast<std::size_t>(in.count("removed"));
+  if (steps_ < 0) in.fail("steps", fmt::format("{} steps, which no run holds: the checkpoint is damaged", steps_));
+  const auto removed = in.count("removed");
+  if (removed < 0) in.fail("removed", fmt::format("{} particles removed, which no run holds: the checkpoint is damaged", removed));
+  removed_ = static_cast<std::size_t>(removed);
   dissipated_ = Energies::load(in, "dissipated");
   platen_displacement_ = in.numbers("platen_displacement", settings_.platens.size());
   const auto settling = in.numbers("settling_kinetic", 2);

@@ -69,7 +69,7 @@ Dissipation DruckerPrager<Dim>::update_chunk(Particles<Dim>& p, std::span<const 
 // Most particles, most steps, lie inside the cone, and return_map found so
 // one at a time through a division and a square root: a seventh of a linear
 // Drucker-Prager step under GCC's Zen 1 tuning, which vectorises two doubles
-// at a time (README.md, "The same builds on another processor"). Lanes
+// at a time (docs/performance/index.md#hosts). Lanes
 // decide the same for a chunk with neither: f <= 0 is sqrt(J2) <= r = k -
 // alpha mean, so J2 <= r^2 for r >= 0. The lanes' mean (a product by 1/3,
 // not a division) and sums differ from return_map's by tens of ulps of S (1
